@@ -1,7 +1,9 @@
 // The paper's Figure 5: "bumping" the pendulum to a higher energy by integrating the Riemann
 // gradient of the learned H between two stretches along its symplectic gradient.
 
+#include <algorithm>
 #include <cmath>
+#include <numeric>
 
 #include "physics/integrator.h"
 #include "tasks/files.h"
@@ -15,7 +17,9 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr int kRiemannPoints = 11;  // outputs during the Riemann phase
+constexpr int kRiemannPoints = 11;      // outputs during the Riemann phase
+constexpr double kMaxRiemannTime = 50;  // longest search along R_H for the asked rise of H
+constexpr int kProbePoints = 5001;      // its resolution: 0.01 time units
 constexpr int kScale = 3, kGap = 2, kSide = physics::GymPendulum::kSide;
 
 struct Phase {
@@ -44,17 +48,22 @@ BumpResult energy_bump(const PixelModel<double>& model, const PixelData& data,
                        const PixelConfig& config, const BumpOptions& o) {
   (void)config;
   HNN_TASKS_CHECK(model.is_hnn(), "the energy bump needs an HNN run: a baseline learns no H");
-  HNN_TASKS_CHECK(o.trajectory >= 0 && o.trajectory < data.test_trials(),
-                  "--trajectory must be in [0, {}), got {}", data.test_trials(), o.trajectory);
-  HNN_TASKS_CHECK(o.before > 0 && o.after > 0 && o.dt > 0 && std::isfinite(o.riemann),
-                  "bump: --before, --after and --dt must be positive and --riemann finite");
+  HNN_TASKS_CHECK(o.trajectory >= -1 && o.trajectory < data.test_trials(),
+                  "--trajectory must be in [0, {}) (or -1: automatic), got {}", data.test_trials(),
+                  o.trajectory);
+  HNN_TASKS_CHECK(o.before > 0 && o.after > 0 && o.dt > 0,
+                  "bump: --before, --after and --dt must be positive");
+  HNN_TASKS_CHECK(
+      std::isfinite(o.riemann) && std::isfinite(o.raise) && (o.riemann != 0 || o.raise != 0),
+      "bump: give a non-zero --raise or --riemann");
   const physics::GymPendulum scene;
   const nn::DynamicsModel<double>& dynamics = model.dynamics();
   const physics::VectorField symplectic =
       [&dynamics](double, const physics::Batch& z, physics::Batch& dz) { dz = dynamics.field(z); };
   // S_H = (dH/dp, -dH/dq), so R_H = (dH/dq, dH/dp) = (-S_p, S_q): H grows along it at the rate
-  // |grad H|^2. A negative duration follows -R_H and lowers H.
-  const double sign = o.riemann >= 0 ? 1.0 : -1.0;
+  // |grad H|^2. Lowering H follows -R_H.
+  const double target_sign = o.riemann != 0 ? o.riemann : o.raise;
+  const double sign = target_sign >= 0 ? 1.0 : -1.0;
   const physics::VectorField riemann = [&dynamics, sign](double, const physics::Batch& z,
                                                          physics::Batch& dz) {
     const physics::Batch s = dynamics.field(z);
@@ -62,19 +71,55 @@ BumpResult energy_bump(const PixelModel<double>& model, const PixelData& data,
     dz.col(0) = -sign * s.col(1);
     dz.col(1) = sign * s.col(0);
   };
-  const std::vector<Eigen::Index> start = {Eigen::Index(o.trajectory) * data.pairs_per_trial()};
-  const physics::Batch z0 = model.encode(data.pairs_of<double>(start, false));
+  // The test trials' first pairs: their learned H sets the scale of `raise`; the default start
+  // is the trial at the 25th percentile of their H (room to rise; the 75th to fall).
+  std::vector<Eigen::Index> firsts;
+  for (int i = 0; i < data.test_trials(); ++i)
+    firsts.push_back(Eigen::Index(i) * data.pairs_per_trial());
+  const Eigen::VectorXd h_firsts =
+      model.energy(model.encode(data.pairs_of<double>(firsts, false))).col(0);
+  int trajectory = o.trajectory;
+  if (trajectory < 0) {
+    std::vector<int> order(firsts.size());
+    std::iota(order.begin(), order.end(), 0);
+    std::sort(order.begin(), order.end(), [&](int a, int b) { return h_firsts(a) < h_firsts(b); });
+    trajectory = order[sign > 0 ? order.size() / 4 : order.size() * 3 / 4];
+  }
+  const physics::Batch z0 =
+      model.encode(data.pairs_of<double>({firsts[std::size_t(trajectory)]}, false));
   const auto points = [&](double duration) {
     return std::max(2, int(std::lround(duration / o.dt)) + 1);
   };
   std::vector<Phase> phases;
   phases.push_back(integrate_phase("symplectic", symplectic, z0, o.before, points(o.before)));
-  phases.push_back(integrate_phase("riemann", riemann, phases[0].z.bottomRows(1),
-                                   std::max(std::abs(o.riemann), 1e-12), kRiemannPoints));
+  const physics::Batch z1 = phases[0].z.bottomRows(1);
+  double duration = std::abs(o.riemann);
+  if (o.riemann == 0) {  // find the time at which H has risen (or fallen) by raise x spread
+    const double h1 = model.energy(z1)(0, 0);
+    const double target = h1 + o.raise * (h_firsts.maxCoeff() - h_firsts.minCoeff());
+    const Phase probe = integrate_phase("riemann", riemann, z1, kMaxRiemannTime, kProbePoints);
+    const Eigen::VectorXd h = model.energy(probe.z).col(0);
+    duration = kMaxRiemannTime;
+    for (Eigen::Index k = 1; k < h.size(); ++k) {
+      if ((h(k) - target) * sign >= 0) {  // crossed: interpolate the time linearly
+        const double f = (target - h(k - 1)) / (h(k) - h(k - 1));
+        duration = probe.t[std::size_t(k) - 1] +
+                   f * (probe.t[std::size_t(k)] - probe.t[std::size_t(k) - 1]);
+        break;
+      }
+    }
+    HNN_TASKS_CHECK(duration < kMaxRiemannTime,
+                    "bump: H did not change by {} x its spread within {} time units along R_H",
+                    o.raise, kMaxRiemannTime);
+  }
+  phases.push_back(
+      integrate_phase("riemann", riemann, z1, std::max(duration, 1e-9), kRiemannPoints));
   phases.push_back(integrate_phase("symplectic-after", symplectic, phases[1].z.bottomRows(1),
                                    o.after, points(o.after)));
 
   BumpResult result;
+  result.trajectory = trajectory;
+  result.riemann_time = duration;
   std::string csv = "phase,t,z_q,z_p,learned_h,theta,p,energy\n";
   std::vector<GrayImage> images;
   std::vector<double> h_before, h_after, e_before, e_after;

@@ -229,15 +229,23 @@ void write_comparison(const std::filesystem::path& baseline_run,
 // ---- the energy bump (tasks/pixel_bump.cpp) -------------------------------------------------
 
 /// Figure 5: from an encoded test pair, integrate the symplectic gradient S_H for `before`
-/// frames, the Riemann gradient R_H = (dH/dq, dH/dp) for `riemann` (raising H when positive,
-/// lowering it when negative), then S_H for `after` frames.
+/// frames, then the Riemann gradient R_H = (dH/dq, dH/dp) (or -R_H to lower H), then S_H for
+/// `after` frames. The learned H grows along R_H at the rate |grad H|^2, which varies a lot over
+/// the latent plane, so the bump is given as a rise in H: `raise` times the spread of H over the
+/// test trials' first pairs (keeping the bumped swing among the energies the model was trained
+/// on), unless a fixed `riemann` time is given.
 struct BumpOptions {
-  int trajectory = 0;  // which rollout trial starts it
-  double before = 60, riemann = 1.0, after = 100;
-  double dt = 0.5;            // output spacing (frames)
+  int trajectory =
+      -1;  // test trial that starts it; -1: at the 25th percentile of H (75th to lower)
+  double before = 60, after = 100;
+  double raise = 0.5;         // rise of H as a fraction of its spread (negative: lower H)
+  double riemann = 0;         // when non-zero: time along R_H (negative: along -R_H), not `raise`
+  double dt = 1;              // output spacing (frames): the GIF runs in real time
   std::filesystem::path out;  // folder; default the run folder
 };
 struct BumpResult {
+  int trajectory = 0;
+  double riemann_time = 0;                           // time spent along R_H
   double h_before = 0, h_after = 0;                  // learned H in each S_H phase (mean)
   double energy_before = 0, energy_after = 0;        // true energy recovered from decoded frames
   double amplitude_before = 0, amplitude_after = 0;  // max |theta| of the decoded frames

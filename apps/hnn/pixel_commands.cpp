@@ -24,15 +24,19 @@ void add_bump_command(CLI::App& app) {
   cmd->add_option("run", *dir, "Run folder of `hnn train pixel-pendulum --model hnn`")
       ->required()
       ->check(CLI::ExistingDirectory);
-  cmd->add_option("--trajectory", o->trajectory, "Test trial whose first pair starts it")
-      ->check(CLI::NonNegativeNumber)
+  cmd->add_option("--trajectory", o->trajectory,
+                  "Test trial whose first pair starts it (-1: the one at the 25th percentile of H)")
+      ->check(CLI::Range(-1, 1000000))
       ->capture_default_str();
   cmd->add_option("--before", o->before, "Frames along S_H before the bump")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
-  cmd->add_option("--riemann", o->riemann,
-                  "Time along R_H = (dH/dq, dH/dp) (negative: along -R_H, lowering H)")
+  cmd->add_option("--raise", o->raise,
+                  "Rise of the learned H along R_H, as a fraction of its spread over the test "
+                  "trials (negative: lower it along -R_H)")
       ->capture_default_str();
+  cmd->add_option("--riemann", o->riemann,
+                  "Instead of --raise: this long along R_H (negative: along -R_H)");
   cmd->add_option("--after", o->after, "Frames along S_H after the bump")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
@@ -46,10 +50,10 @@ void add_bump_command(CLI::App& app) {
     options.out = *out;
     const tasks::pixel::BumpResult r = tasks::pixel::energy_bump(*dir, options);
     fmt::print(
-        "hnn bump: learned H {:.4g} -> {:.4g}; energy from frames {:.4g} -> {:.4g}; "
-        "amplitude {:.3f} -> {:.3f} rad\n",
-        r.h_before, r.h_after, r.energy_before, r.energy_after, r.amplitude_before,
-        r.amplitude_after);
+        "hnn bump: test trial {}, {:.3g} time units along R_H: learned H {:.4g} -> {:.4g}; "
+        "energy from frames {:.4g} -> {:.4g}; amplitude {:.3f} -> {:.3f} rad\n",
+        r.trajectory, r.riemann_time, r.h_before, r.h_after, r.energy_before, r.energy_after,
+        r.amplitude_before, r.amplitude_after);
     for (const auto& f : r.files) fmt::print("  {}\n", f.string());
   });
 }

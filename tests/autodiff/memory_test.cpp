@@ -57,10 +57,13 @@ TEST(TapeMemory, ThousandScopedTrainingStepsKeepTheTapeAndRssFlat) {
     ASSERT_EQ(tape.size(), mark) << "tape not rewound at step " << step;
     if (step == 20) rss_after_warmup = ad::testing::resident_bytes();
   }
-  const long growth = ad::testing::resident_bytes() - rss_after_warmup;
+  [[maybe_unused]] const long growth = ad::testing::resident_bytes() - rss_after_warmup;
   // One unreleased step of this model holds ~0.4 MB of node values (measured), so 980 leaked
-  // steps would show as ~400 MB; allow a little allocator noise.
+  // steps would show as ~400 MB; allow a little allocator noise. Not under AddressSanitizer,
+  // whose quarantine holds freed blocks (up to 256 MB): there LeakSanitizer checks instead.
+#if !defined(__SANITIZE_ADDRESS__)
   EXPECT_LT(growth, 1 << 20) << "RSS grew by " << growth << " bytes over 980 steps";
+#endif
   EXPECT_LT(loss, 0.05 * first_loss)
       << "training did not progress: " << first_loss << " -> " << loss;
 }
