@@ -35,6 +35,7 @@ struct Node {
   std::vector<Var<T>> inputs;         // capacity kept across recycling: no allocation per step
   BackwardFn<T> backward = nullptr;   // null for leaves and for results that need no gradient
   std::array<double, 3> saved{};      // op constants (exponent, offsets, ...)
+  std::vector<Matrix<T>> buffers;     // fused ops' saved intermediates; kept across recycling
   const char* op = "leaf";
   bool requires_grad = false;
   bool is_leaf = false;

@@ -64,6 +64,19 @@ ad::Var<T> Hnn<T>::dissipation(const ad::Var<T>& x) const {
 template <typename T>
 typename Hnn<T>::Parts Hnn<T>::time_derivative_parts(const ad::Var<T>& x) const {
   this->check_input("time_derivative", x.rows(), x.cols());
+  const FieldType field = this->config_.field;
+  Parts parts;
+  if (field != FieldType::kBoth && this->mlp_.has_fused_input_gradient()) {
+    // One fused op gives dH/dx (or dD/dx) and, in training, its exact parameter gradients.
+    const ad::Var<T> dh = this->mlp_.input_gradient(x);
+    if (field == FieldType::kConservative) {
+      parts.conservative = dh;
+    } else {
+      const Index n = this->config_.dim / 2;
+      parts.solenoidal = ad::concat_cols<T>({ad::slice_cols(dh, n, n), -ad::slice_cols(dh, 0, n)});
+    }
+    return parts;
+  }
   // Training (grad mode on) keeps the derivative on the graph; under a NoGradGuard it is a
   // value. Either way the scalars themselves must be recorded to be differentiated.
   const bool create_graph = ad::grad_enabled();
@@ -75,8 +88,6 @@ typename Hnn<T>::Parts Hnn<T>::time_derivative_parts(const ad::Var<T>& x) const 
     const ad::Var<T> scalar = out.cols() == 1 ? out : ad::slice_cols(out, column, 1);
     return ad::grad<T>({ad::sum(scalar)}, {input}, options)[0];
   };
-  Parts parts;
-  const FieldType field = this->config_.field;
   if (field != FieldType::kConservative) {
     const ad::Var<T> dh = gradient_of_column(0);
     const Index n = this->config_.dim / 2;

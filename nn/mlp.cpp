@@ -5,6 +5,8 @@
 
 #include <stdexcept>
 
+#include "autodiff/mlp_ops.h"
+
 namespace hnn::nn {
 
 namespace {
@@ -36,6 +38,7 @@ Mlp<T>::Mlp(MlpConfig config, std::mt19937_64& rng) : config_(std::move(config))
     const bool bias = i + 1 < n || config_.last_bias;
     layers_.emplace_back(config_.widths[i], config_.widths[i + 1], rng, config_.init, bias);
   }
+  collect_parameters();
 }
 
 template <typename T>
@@ -58,10 +61,22 @@ Mlp<T>::Mlp(MlpConfig config, std::vector<Linear<T>> layers)
                       config_.widths[i], config_.widths[i + 1], bias ? "with" : "no"));
     }
   }
+  collect_parameters();
+}
+
+template <typename T>
+void Mlp<T>::collect_parameters() {
+  weights_.clear();
+  biases_.clear();
+  for (const Linear<T>& layer : layers_) {
+    weights_.push_back(layer.weight());
+    biases_.push_back(layer.bias());
+  }
 }
 
 template <typename T>
 ad::Var<T> Mlp<T>::forward(const ad::Var<T>& x) const {
+  if (config_.activation == Activation::kTanh) return ad::tanh_mlp(x, weights_, biases_);
   ad::Var<T> h = layers_.front().forward(x);
   for (std::size_t i = 1; i < layers_.size(); ++i) {
     h = layers_[i].forward(activate(config_.activation, h));
@@ -70,10 +85,20 @@ ad::Var<T> Mlp<T>::forward(const ad::Var<T>& x) const {
 }
 
 template <typename T>
+ad::Var<T> Mlp<T>::input_gradient(const ad::Var<T>& x) const {
+  if (!has_fused_input_gradient()) {
+    throw std::logic_error(fmt::format(
+        "Mlp::input_gradient: needs a tanh MLP with one output, not {}", describe(config_)));
+  }
+  return ad::tanh_mlp_input_gradient(x, weights_, biases_);
+}
+
+template <typename T>
 void Mlp<T>::visit_parameters(const ParameterVisitor<T>& visit) {
   for (std::size_t i = 0; i < layers_.size(); ++i) {
     visit_child<T>(layers_[i], fmt::format("layers.{}", i), visit);
   }
+  collect_parameters();  // the visitor may have rebound them (bind_parameters)
 }
 
 template <typename T>

@@ -34,7 +34,15 @@ class Mlp : public Module<T> {
   Mlp(Mlp&&) noexcept = default;
   Mlp& operator=(Mlp&&) noexcept = default;
 
+  /// A tanh MLP runs as one fused op (ad::tanh_mlp); other activations layer by layer.
   ad::Var<T> forward(const ad::Var<T>& x) const;
+  /// For a tanh MLP with one output: d y / d x row by row, as one fused op that training can
+  /// differentiate (ad::tanh_mlp_input_gradient). Throws std::logic_error otherwise.
+  ad::Var<T> input_gradient(const ad::Var<T>& x) const;
+  /// Whether input_gradient() is available.
+  bool has_fused_input_gradient() const {
+    return config_.activation == Activation::kTanh && output_dim() == 1;
+  }
 
   const MlpConfig& config() const { return config_; }
   const std::vector<Linear<T>>& layers() const { return layers_; }
@@ -54,8 +62,11 @@ class Mlp : public Module<T> {
   }
 
  private:
+  void collect_parameters();
+
   MlpConfig config_;
   std::vector<Linear<T>> layers_;
+  std::vector<ad::Var<T>> weights_, biases_;  // handles of layers_' parameters, for fused ops
 };
 
 }  // namespace hnn::nn

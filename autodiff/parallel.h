@@ -1,0 +1,47 @@
+#pragma once
+// The engine's worker threads: fused kernels split a batch into row blocks, one per thread.
+// Workers are created once and sleep between jobs (futex waits, no spinning that would steal a
+// shared machine's cores), so a training step costs two wake-ups, not thread creation.
+
+#include <Eigen/Core>
+#include <type_traits>
+
+namespace hnn::ad {
+
+/// Threads the fused kernels may use (default: the hardware's, at most 8). n >= 1.
+void set_num_threads(int n);
+int num_threads();
+
+/// A non-owning callable void(int): no allocation, unlike std::function.
+class PartFn {
+ public:
+  // Refers to f, which must outlive the call (a lambda argument lives until the call returns).
+  template <typename F>
+  requires(!std::is_same_v<std::decay_t<F>, PartFn>) PartFn(F&& f)  // NOLINT: implicit by design
+      : object_(const_cast<void*>(static_cast<const void*>(&f))),
+        call_([](void* o, int i) { (*static_cast<std::remove_reference_t<F>*>(o))(i); }) {}
+  void operator()(int i) const { call_(object_, i); }
+
+ private:
+  void* object_;
+  void (*call_)(void*, int);
+};
+
+/// Calls part(i) for i in [0, parts) concurrently (the caller runs part 0) and returns when all
+/// have finished; the first exception thrown by a part is rethrown here. Nested calls, and calls
+/// while another thread's job holds the workers, run the same parts serially: the split (and so
+/// every result, bit for bit) depends only on `parts`.
+void parallel_for(int parts, PartFn part);
+
+/// Row block i of `parts` equal blocks of `rows`: [begin, end).
+struct RowBlock {
+  Eigen::Index begin, end;
+  Eigen::Index size() const { return end - begin; }
+};
+RowBlock row_block(Eigen::Index rows, int parts, int i);
+
+/// How many parts a batch of `rows` is worth splitting into: one per thread, but at least
+/// `min_rows` rows each (below that, waking a thread costs more than it saves).
+int parts_for(Eigen::Index rows, Eigen::Index min_rows = 64);
+
+}  // namespace hnn::ad
