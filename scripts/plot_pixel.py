@@ -68,11 +68,14 @@ def draw_fig4(results):
     has_strip = os.path.isfile(strip)
     if not has_strip:
         note(f"{TASK}/rollout_strip.png: missing (run `hnn animate`), strip skipped")
-    fig = plt.figure(figsize=(10, 7.2 if has_strip else 3.6))
-    grid = fig.add_gridspec(2 if has_strip else 1, 3, height_ratios=[1.1, 1] if has_strip else [1])
+    image = plt.imread(strip) if has_strip else None
+    # The strip's row is as tall as the image needs at the figure's width (plus its labels).
+    strip_height = 10 * image.shape[0] / image.shape[1] + 0.9 if has_strip else 0
+    fig = plt.figure(figsize=(10, 3.6 + strip_height))
+    grid = fig.add_gridspec(2 if has_strip else 1, 3,
+                            height_ratios=[strip_height, 3.6] if has_strip else [1])
     if has_strip:
         ax = fig.add_subplot(grid[0, :])
-        image = plt.imread(strip)
         ax.imshow(image, cmap="gray", vmin=0, vmax=1, interpolation="nearest")
         rows = 3
         height = image.shape[0] / rows

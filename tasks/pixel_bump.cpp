@@ -36,6 +36,13 @@ Phase integrate_phase(const char* name, const physics::VectorField& field, const
   return p;
 }
 
+// Each state advanced one frame along S_H: with it, a latent state's pendulum state is read
+// from two decoded frames one time step apart (Note [Velocity from the rollout's frames]).
+physics::Batch one_frame_later(const physics::VectorField& symplectic, const physics::Batch& z) {
+  const auto dopri = physics::make_integrator("dopri5", {.rtol = 1e-9, .atol = 1e-12});
+  return dopri->integrate(symplectic, z, {0.0, 1.0}).states.back();
+}
+
 double mean_of(const std::vector<double>& v) {
   double s = 0;
   for (double x : v) s += x;
@@ -96,7 +103,12 @@ BumpResult energy_bump(const PixelModel<double>& model, const PixelData& data,
   double duration = std::abs(o.riemann);
   if (o.riemann == 0) {  // find the time at which H has risen (or fallen) by raise x spread
     const double h1 = model.energy(z1)(0, 0);
-    const double target = h1 + o.raise * (h_firsts.maxCoeff() - h_firsts.minCoeff());
+    const double spread = h_firsts.maxCoeff() - h_firsts.minCoeff();
+    HNN_TASKS_CHECK(spread > 0,
+                    "bump: --raise is a fraction of the spread of H over the test trials, and {} "
+                    "test trial(s) have none; give --riemann instead",
+                    h_firsts.size());
+    const double target = h1 + o.raise * spread;
     const Phase probe = integrate_phase("riemann", riemann, z1, kMaxRiemannTime, kProbePoints);
     const Eigen::VectorXd h = model.energy(probe.z).col(0);
     duration = kMaxRiemannTime;
@@ -128,8 +140,10 @@ BumpResult energy_bump(const PixelModel<double>& model, const PixelData& data,
     const Phase& p = phases[ph];
     const Eigen::VectorXd h = model.energy(p.z).col(0);
     const physics::Batch pairs = model.decode(p.z);
+    const physics::Batch next = model.decode(one_frame_later(symplectic, p.z));
     for (Eigen::Index k = (ph == 0 ? 0 : 1); k < p.z.rows(); ++k) {  // phases share endpoints
-      const Eigen::RowVector2d x = state_from_pair(scene, pairs.row(k));
+      const Eigen::RowVector2d x =
+          state_from_frames(scene, pairs.row(k).head(kFramePixels), next.row(k).head(kFramePixels));
       const double e = scene.energy(x);
       csv += fmt::format("{},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g}\n", p.name,
                          t0 + p.t[std::size_t(k)], p.z(k, 0), p.z(k, 1), h(k), x(0), x(1), e);

@@ -163,6 +163,10 @@ Eigen::RowVector2d pair_state(double th_a, double th_b);
 /// GymPendulum::angle_from_frame (the intensity centroid); NaNs for a blank frame.
 Eigen::RowVector2d state_from_pair(const physics::GymPendulum& scene,
                                    const Eigen::Ref<const Eigen::RowVectorXd>& pair);
+/// pair_state of the angles recovered from two frames (784 values each) one time step apart.
+Eigen::RowVector2d state_from_frames(const physics::GymPendulum& scene,
+                                     const Eigen::Ref<const Eigen::RowVectorXd>& first,
+                                     const Eigen::Ref<const Eigen::RowVectorXd>& second);
 
 /// Latent rollouts from the first pair of each rollout trial (all trials integrated together
 /// by dopri5, time unit = one frame), decoded, against the true Gym continuation.
@@ -171,7 +175,10 @@ struct PixelRollouts {
   std::vector<Eigen::MatrixXd> z;                   // per trajectory: times x 2 latent states
   Eigen::MatrixXd frame_mse;                        // trajectories x times: MSE of the decoded pair
   Eigen::MatrixXd true_theta, true_p, true_energy;  // pair_state of the true angles
-  Eigen::MatrixXd pred_theta, pred_p, pred_energy;  // recovered from the decoded frames
+  /// pair_state of the angles of the first frames of decoded pairs k and k + 1: the rollout's
+  /// own frames over time (Note [Velocity from the rollout's frames], pixel_rollout.cpp).
+  Eigen::MatrixXd pred_theta, pred_p, pred_energy;
+  Eigen::MatrixXd pair_energy;    // from the two frames of one decoded pair (decoder-biased)
   Eigen::MatrixXd frames_energy;  // recovered from the true frames: the method's floor
   Eigen::MatrixXd learned_h;      // the HNN's H along its latent path (empty otherwise)
   std::vector<bool> failed;
@@ -183,8 +190,15 @@ struct PixelRollouts {
 PixelRollouts pixel_rollouts(const PixelModel<double>& model, const PixelData& data,
                              const PixelConfig& config, int keep = 4);
 
+/// Which recovered energy pixel_energy_mse compares with the true one.
+enum class EnergySource {
+  kRollout,     // pred_energy: the headline metric
+  kWithinPair,  // pair_energy
+  kTrueFrames,  // frames_energy: the floor of recovering states from frames
+};
 /// Energy MSE over trajectories and times with the 5-split standard error of tasks::energy_mse.
-nn::MeanStderr pixel_energy_mse(const PixelRollouts& rollouts, bool floor = false);
+nn::MeanStderr pixel_energy_mse(const PixelRollouts& rollouts,
+                                EnergySource source = EnergySource::kRollout);
 
 // ---- run folders (tasks/pixel_run.cpp) --------------------------------------------------------
 
@@ -252,6 +266,8 @@ struct BumpResult {
   std::vector<std::filesystem::path> files;
 };
 /// Writes bump.csv (phase,t,z_q,z_p,learned_h,theta,p,energy), bump.gif and bump_strip.png.
+/// theta, p and energy: state_from_frames of the decoded state and of the state one frame later
+/// along S_H.
 BumpResult energy_bump(const std::filesystem::path& run_dir, const BumpOptions& options);
 BumpResult energy_bump(const PixelModel<double>& model, const PixelData& data,
                        const PixelConfig& config, const BumpOptions& options);

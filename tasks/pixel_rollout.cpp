@@ -34,8 +34,13 @@ Eigen::RowVector2d pair_state(double th_a, double th_b) {
 
 Eigen::RowVector2d state_from_pair(const physics::GymPendulum& scene,
                                    const Eigen::Ref<const Eigen::RowVectorXd>& pair) {
-  return pair_state(frame_angle(scene, pair.head(kFramePixels)),
-                    frame_angle(scene, pair.tail(kFramePixels)));
+  return state_from_frames(scene, pair.head(kFramePixels), pair.tail(kFramePixels));
+}
+
+Eigen::RowVector2d state_from_frames(const physics::GymPendulum& scene,
+                                     const Eigen::Ref<const Eigen::RowVectorXd>& first,
+                                     const Eigen::Ref<const Eigen::RowVectorXd>& second) {
+  return pair_state(frame_angle(scene, first), frame_angle(scene, second));
 }
 
 PixelRollouts pixel_rollouts(const PixelModel<double>& model, const PixelData& data,
@@ -47,8 +52,11 @@ PixelRollouts pixel_rollouts(const PixelModel<double>& model, const PixelData& d
   const Eigen::Index m = frames + 1;
   PixelRollouts r;
   r.t = physics::linspace(0.0, double(frames), frames + 1);
-  for (Eigen::MatrixXd* mat : {&r.frame_mse, &r.true_theta, &r.true_p, &r.true_energy,
-                               &r.pred_theta, &r.pred_p, &r.pred_energy, &r.frames_energy}) {
+  // One frame more than reported: the state at time k needs the angle of frame k + 1.
+  const std::vector<double> t_ext = physics::linspace(0.0, double(frames + 1), frames + 2);
+  for (Eigen::MatrixXd* mat :
+       {&r.frame_mse, &r.true_theta, &r.true_p, &r.true_energy, &r.pred_theta, &r.pred_p,
+        &r.pred_energy, &r.pair_energy, &r.frames_energy}) {
     mat->setConstant(n, m, NAN);
   }
   if (model.is_hnn()) r.learned_h.setConstant(n, m, NAN);
@@ -82,7 +90,7 @@ PixelRollouts pixel_rollouts(const PixelModel<double>& model, const PixelData& d
     const physics::Batch z0 = model.encode(data.pairs_of<double>({row}, false));
     Eigen::MatrixXd z;
     try {
-      const physics::Trajectory path = dopri->integrate(field, z0, r.t);
+      const physics::Trajectory path = dopri->integrate(field, z0, t_ext);
       r.nfev += path.stats.nfev;
       z = path.path(0);
       r.failed.push_back(false);
@@ -96,30 +104,43 @@ PixelRollouts pixel_rollouts(const PixelModel<double>& model, const PixelData& d
       }
       continue;
     }
-    r.z.push_back(z);
-    const physics::Batch pred = model.decode(physics::Batch(z));
-    r.frame_mse.row(i) = (pred - truth).array().square().rowwise().mean().transpose();
-    physics::Batch recovered(m, 2);
-    for (Eigen::Index k = 0; k < m; ++k)
-      recovered.row(k).head<2>() = state_from_pair(scene, pred.row(k));
+    r.z.push_back(z.topRows(m));
+    const physics::Batch pred = model.decode(physics::Batch(z));  // m + 1 pairs
+    r.frame_mse.row(i) = (pred.topRows(m) - truth).array().square().rowwise().mean().transpose();
+    // Note [Velocity from the rollout's frames]: the state at time k is pair_state of the angles
+    // of the first frames of decoded pairs k and k + 1, as the true state is that of frames k
+    // and k + 1. The angle difference inside one decoded pair is not used for it: the decoder
+    // renders that difference about 20% too small even for encoded true pairs (measured, seed
+    // 0: p recovered = 0.78 p at t = 0 for both models), a bias of the autoencoder that would
+    // swamp the dynamics' energy error. It stays in pair_energy for comparison.
+    physics::Batch recovered(m, 2), within_pair(m, 2);
+    for (Eigen::Index k = 0; k < m; ++k) {
+      recovered.row(k).head<2>() = state_from_frames(scene, pred.row(k).head(kFramePixels),
+                                                     pred.row(k + 1).head(kFramePixels));
+      within_pair.row(k).head<2>() = state_from_pair(scene, pred.row(k));
+    }
     r.pred_theta.row(i) = recovered.col(0).transpose();
     r.pred_p.row(i) = recovered.col(1).transpose();
     r.pred_energy.row(i) = scene.energy_batch(recovered).transpose();
-    if (model.is_hnn()) r.learned_h.row(i) = model.energy(physics::Batch(z)).col(0).transpose();
+    r.pair_energy.row(i) = scene.energy_batch(within_pair).transpose();
+    if (model.is_hnn())
+      r.learned_h.row(i) = model.energy(physics::Batch(z.topRows(m))).col(0).transpose();
     if (i < keep) {
       r.true_frames.push_back(truth.rightCols(kFramePixels).cast<float>());
-      r.pred_frames.push_back(pred.rightCols(kFramePixels).cast<float>());
+      r.pred_frames.push_back(pred.topRows(m).rightCols(kFramePixels).cast<float>());
     }
   }
   return r;
 }
 
-nn::MeanStderr pixel_energy_mse(const PixelRollouts& r, bool floor) {
+nn::MeanStderr pixel_energy_mse(const PixelRollouts& r, EnergySource source) {
   Rollouts view;
   view.t = r.t;
   view.failed = r.failed;
   view.true_energy = r.true_energy;
-  view.pred_energy = floor ? r.frames_energy : r.pred_energy;
+  view.pred_energy = source == EnergySource::kTrueFrames   ? r.frames_energy
+                     : source == EnergySource::kWithinPair ? r.pair_energy
+                                                           : r.pred_energy;
   // A frame whose angle cannot be recovered (blank) makes its trajectory fail the metric.
   for (Eigen::Index i = 0; i < view.pred_energy.rows(); ++i) {
     if (!view.pred_energy.row(i).allFinite()) view.failed[std::size_t(i)] = true;

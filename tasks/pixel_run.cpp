@@ -75,15 +75,16 @@ void write_strip(const fs::path& path, const std::vector<const Eigen::MatrixXf*>
 std::string rollout_csv(const PixelRollouts& r) {
   std::string csv =
       "traj,frame,frame_mse,true_theta,true_p,true_energy,pred_theta,pred_p,pred_energy,"
-      "frames_energy,z_q,z_p,learned_h\n";
+      "frames_energy,z_q,z_p,learned_h,pair_energy\n";
   for (Eigen::Index i = 0; i < r.true_energy.rows(); ++i) {
     for (Eigen::Index k = 0; k < Eigen::Index(r.t.size()); ++k) {
-      csv += fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{}\n", i, r.t[std::size_t(k)],
-                         cell(r.frame_mse(i, k)), cell(r.true_theta(i, k)), cell(r.true_p(i, k)),
-                         cell(r.true_energy(i, k)), cell(r.pred_theta(i, k)), cell(r.pred_p(i, k)),
-                         cell(r.pred_energy(i, k)), cell(r.frames_energy(i, k)),
-                         cell(r.z[std::size_t(i)](k, 0)), cell(r.z[std::size_t(i)](k, 1)),
-                         r.learned_h.size() ? cell(r.learned_h(i, k)) : "");
+      csv +=
+          fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", i, r.t[std::size_t(k)],
+                      cell(r.frame_mse(i, k)), cell(r.true_theta(i, k)), cell(r.true_p(i, k)),
+                      cell(r.true_energy(i, k)), cell(r.pred_theta(i, k)), cell(r.pred_p(i, k)),
+                      cell(r.pred_energy(i, k)), cell(r.frames_energy(i, k)),
+                      cell(r.z[std::size_t(i)](k, 0)), cell(r.z[std::size_t(i)](k, 1)),
+                      r.learned_h.size() ? cell(r.learned_h(i, k)) : "", cell(r.pair_energy(i, k)));
     }
   }
   return csv;
@@ -153,7 +154,9 @@ json evaluate_model(const PixelModel<double>& model, const PixelData& data,
   const PixelLossStats train = pixel_loss_stats(model, data, false, config.hnn_weight);
   const PixelLossStats test = pixel_loss_stats(model, data, true, config.hnn_weight);
   const PixelRollouts r = pixel_rollouts(model, data, config, 2);
-  const nn::MeanStderr energy = pixel_energy_mse(r), floor = pixel_energy_mse(r, true);
+  const nn::MeanStderr energy = pixel_energy_mse(r);
+  const nn::MeanStderr floor = pixel_energy_mse(r, EnergySource::kTrueFrames);
+  const nn::MeanStderr within_pair = pixel_energy_mse(r, EnergySource::kWithinPair);
   Eigen::VectorXd frame_mse = Eigen::VectorXd::Zero(Eigen::Index(r.t.size()));
   int used = 0;
   for (Eigen::Index i = 0; i < r.frame_mse.rows(); ++i) {
@@ -177,6 +180,8 @@ json evaluate_model(const PixelModel<double>& model, const PixelData& data,
             {"n_test", data.test_rows},
             {"loss_terms", {{"train", terms(train)}, {"test", terms(test)}}},
             {"energy_mse_frames_floor", number(floor.mean)},
+            {"energy_mse_within_pair", number(within_pair.mean)},
+            {"energy_mse_within_pair_se", number(within_pair.std_error)},
             {"frame_mse_mean", number(frame_mse.mean())},
             {"frame_mse_first", number(frame_mse(0))},
             {"frame_mse_last", number(frame_mse(frame_mse.size() - 1))},
@@ -336,7 +341,8 @@ fs::path write_pixel_rollout(const fs::path& run_dir, const PixelRolloutOptions&
   const physics::Batch z0 = run.model->encode(run.data.pairs_of<double>(rows, false));
   const auto integrator =
       physics::make_integrator(o.integrator, {.dt = o.dt, .rtol = o.rtol, .atol = o.rtol * 1e-3});
-  const std::vector<double> t = physics::linspace(0.0, o.frames, o.frames + 1);
+  // One frame past the last reported: its angle gives the last state's velocity.
+  const std::vector<double> t = physics::linspace(0.0, o.frames + 1, o.frames + 2);
   const nn::DynamicsModel<double>& dynamics = run.model->dynamics();
   const physics::Trajectory path = integrator->integrate(
       [&dynamics](double, const physics::Batch& z, physics::Batch& dz) { dz = dynamics.field(z); },
@@ -355,8 +361,11 @@ fs::path write_pixel_rollout(const fs::path& run_dir, const PixelRolloutOptions&
     const physics::Batch pairs = run.model->decode(z);
     Eigen::VectorXd h;
     if (run.model->is_hnn()) h = run.model->energy(z).col(0);
-    for (Eigen::Index k = 0; k < z.rows(); ++k) {
-      const Eigen::RowVector2d x = state_from_pair(scene, pairs.row(k));
+    // As pixel_rollouts (Note [Velocity from the rollout's frames]): the first frames of
+    // consecutive decoded pairs.
+    for (Eigen::Index k = 0; k + 1 < z.rows(); ++k) {
+      const Eigen::RowVector2d x = state_from_frames(scene, pairs.row(k).head(kFramePixels),
+                                                     pairs.row(k + 1).head(kFramePixels));
       csv += fmt::format("{},{},{},{:.9g},{:.9g},{},{},{},{}\n", run.options.model, i,
                          t[std::size_t(k)], z(k, 0), z(k, 1), cell(x(0)), cell(x(1)),
                          cell(scene.energy(x)), h.size() ? cell(h(k)) : "");

@@ -127,6 +127,27 @@ TEST(PixelState, PairStateKeepsTheTrueEnergyNearlyConstant) {
   EXPECT_GT(swing(own), 0.1);
 }
 
+// A state read from two frames one step apart: state_from_pair reads a pair's two halves the
+// same way, and on rendered frames it recovers the true state (rollouts use it on the first
+// frames of consecutive decoded pairs).
+TEST(PixelState, FromFramesRecoversTheTrueStateOfRenderedFrames) {
+  const physics::GymPendulum scene;
+  const std::vector<physics::GymState> s = scene.rollout(scene.from_canonical(0.4, -0.2), 30);
+  for (int k = 0; k < 29; k += 7) {
+    const Eigen::RowVectorXd a = scene.render(s[std::size_t(k)].th);
+    const Eigen::RowVectorXd b = scene.render(s[std::size_t(k) + 1].th);
+    Eigen::RowVectorXd pair(kPairPixels);
+    pair << a, b;
+    const Eigen::RowVector2d from_frames = state_from_frames(scene, a, b);
+    EXPECT_EQ(from_frames, state_from_pair(scene, pair));
+    const Eigen::RowVector2d truth = pair_state(s[std::size_t(k)].th, s[std::size_t(k) + 1].th);
+    EXPECT_NEAR(from_frames(0), truth(0), 0.02) << k;
+    EXPECT_NEAR(from_frames(1), truth(1), 0.05) << k;
+  }
+  EXPECT_TRUE(std::isnan(
+      state_from_frames(scene, Eigen::RowVectorXd::Zero(784), scene.render(s[0].th))(1)));
+}
+
 TEST(PixelData, IsDeterministicInTheSeed) {
   const PixelConfig c = small_config();
   const PixelData a = build_pixel_data(c, 7), b = build_pixel_data(c, 7),
@@ -233,7 +254,8 @@ TEST(PixelRun, WritesTheRunFolderWithReadableGifAndPng) {
   c.steps = 20;
   const nlohmann::json m = run_pixel_training(o, c);
   for (const char* key : {"train_loss", "train_loss_se", "test_loss", "test_loss_se", "energy_mse",
-                          "energy_mse_se", "n_rollouts", "train_seconds", "eval_seconds"}) {
+                          "energy_mse_se", "energy_mse_within_pair", "energy_mse_frames_floor",
+                          "amplitude_ratio", "n_rollouts", "train_seconds", "eval_seconds"}) {
     EXPECT_TRUE(m.contains(key)) << key;
   }
   EXPECT_EQ(m["n_test"], 24);
@@ -279,6 +301,33 @@ TEST(PixelBump, RiemannGradientRaisesTheLearnedH) {
   o.out.clear();
   const BumpResult down = energy_bump(t.model, t.data, t.config, o);
   EXPECT_LT(down.h_after, down.h_before);
+}
+
+// The default mode: follow R_H until H has risen by `raise` x its spread over the test trials'
+// first pairs (12 trials: 2 whole test trials), then S_H keeps the new level.
+TEST(PixelBump, RaiseLiftsTheLearnedHByTheAskedFractionOfItsSpread) {
+  const Trained& t = trained();
+  PixelConfig c = t.config;
+  c.trials = 12;
+  const PixelData d = build_pixel_data(c, 4);
+  ASSERT_EQ(d.test_trials(), 2);
+  const Eigen::VectorXd h =
+      t.model.energy(t.model.encode(d.pairs_of<double>({0, 20}, false))).col(0);
+  const double spread = h.maxCoeff() - h.minCoeff();
+  ASSERT_GT(spread, 0);
+  BumpOptions o;
+  o.before = 5;
+  o.after = 5;
+  o.raise = 0.5;
+  const BumpResult up = energy_bump(t.model, d, c, o);
+  EXPECT_GT(up.riemann_time, 0);
+  // H is conserved along S_H, so the phase means differ by the rise (dopri5 at rtol 1e-9).
+  EXPECT_NEAR(up.h_after - up.h_before, 0.5 * spread, 0.01 * spread);
+  o.raise = -0.25;
+  const BumpResult down = energy_bump(t.model, d, c, o);
+  EXPECT_NEAR(down.h_after - down.h_before, -0.25 * spread, 0.01 * spread);
+  // One test trial has no spread: the raise cannot be scaled.
+  EXPECT_THROW(energy_bump(t.model, t.data, t.config, BumpOptions{}), std::runtime_error);
 }
 
 TEST(PixelBump, RefusesABaseline) {
