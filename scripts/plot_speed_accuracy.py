@@ -138,8 +138,11 @@ def plot_time_panel(ax_time, ax_ratio, series, xlabel):
 
 
 def plot_fd_time(directory):
-    dim = time_series(read_csv(os.path.join(directory, "fd_time_dim.csv")), "dim")
-    params = time_series(read_csv(os.path.join(directory, "fd_time_params.csv")), "params")
+    dim_rows = read_csv(os.path.join(directory, "fd_time_dim.csv"))
+    param_rows = read_csv(os.path.join(directory, "fd_time_params.csv"))
+    dim = time_series(dim_rows, "dim")
+    params = time_series(param_rows, "params")
+    threads = sorted({r.get("threads", "?") for r in dim_rows + param_rows})
     fig, axes = plt.subplots(2, 2, figsize=(10, 7.5))
     plot_time_panel(axes[0, 0], axes[1, 0], dim, "input dimension d (spring 2, two-body 8, "
                     "three-body 12, pixels 1568)")
@@ -149,9 +152,16 @@ def plot_fd_time(directory):
     axes[0, 1].set_title("HNN loss gradient w.r.t. all parameters (spring, 750 states)")
     for ax in axes[:, 0]:
         ax.set_xticks([2, 8, 12, 1568], ["2", "8", "12", "1568"])
+    fd_params = [x for x, *_ in params.get("forward", [])]
+    all_params = [x for x, *_ in params.get("evaluation", [])]
+    if fd_params and max(fd_params) < max(all_params):
+        axes[0, 1].text(0.97, 0.03, f"finite differences timed up to {max(fd_params):.0f} "
+                        "parameters;\nbeyond, one gradient would take minutes",
+                        transform=axes[0, 1].transAxes, ha="right", va="bottom", fontsize=7.5)
     axes[0, 0].legend(loc="upper left")
-    fig.suptitle("Cost of a gradient: autodiff vs finite differences (float64; error bars: "
-                 "min-max over repetitions)", fontsize=10)
+    fig.suptitle("Cost of a gradient: autodiff vs finite differences (float64, "
+                 f"{'/'.join(threads)} engine thread(s); median of interleaved repetitions, "
+                 "error bars min-max)", fontsize=10)
     fig.tight_layout()
     save(fig, directory, "fd_time")
 
@@ -162,11 +172,13 @@ def plot_work_precision(directory):
     fig, axes = plt.subplots(2, len(systems), figsize=(4.2 * len(systems), 7.5), squeeze=False)
     for col, system in enumerate(systems):
         for method, style in METHOD_STYLE.items():
-            points = sorted((float(r["seconds"]), float(r["nfev"]), float(r["error"]))
-                            for r in rows if r["system"] == system and r["method"] == method)
+            # In sweep order (largest dt or rtol first), so timing noise cannot reorder the line.
+            points = sorted(((-float(r["value"]), float(r["seconds"]), float(r["nfev"]),
+                              float(r["error"]))
+                             for r in rows if r["system"] == system and r["method"] == method))
             if not points:
                 continue
-            seconds, nfev, error = zip(*points)
+            _, seconds, nfev, error = zip(*points)
             axes[0, col].plot(seconds, error, lw=1.2, ms=4, **style)
             axes[1, col].plot(nfev, error, lw=1.2, ms=4, **style)
         reference = "exact solution" if system == "spring" else "DOPRI5 at rtol 1e-13"
@@ -205,7 +217,7 @@ def plot_energy_drift(directory):
                 ax.plot(*zip(*points), color=style["color"], ls=ls, lw=1.3, label=name)
         title = SYSTEMS.get(system, system)
         if learned:
-            title += "\nlearned field: not separable, so no leapfrog / Yoshida"
+            title += "\nnon-separable H (no leapfrog/Yoshida); periods of the true spring"
             ax.legend(loc="lower right", fontsize=7)
         ax.set(xscale="log", yscale="log", ylim=(1e-16, 10), title=title)
     for ax in axes[1]:

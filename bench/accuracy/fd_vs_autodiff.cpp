@@ -56,8 +56,8 @@ struct TimedMethods {
     const std::vector<Timing> timings = time_interleaved(calls, options);
     for (std::size_t i = 0; i < calls.size(); ++i) {
       const Timing& t = timings[i];
-      csv.row(fmt::format("{},{},{},{:.6e},{:.6e},{:.6e},{}", prefix, names[i], evaluations[i],
-                          t.median, t.min, t.max, t.samples));
+      csv.row(fmt::format("{},{},{},{:.6e},{:.6e},{:.6e},{},{}", prefix, names[i], evaluations[i],
+                          t.median, t.min, t.max, t.samples, ad::num_threads()));
       fmt::print("{:12} {:10} {:10.3e} s ({:.3g} x evaluation)\n", prefix, names[i], t.median,
                  t.median / timings[0].median);
     }
@@ -68,7 +68,7 @@ struct TimedMethods {
 // and one-sided / central differences over all dim inputs.
 void dimension_chart(const std::string& out, bool quick) {
   CsvWriter csv(out + "/fd_time_dim.csv",
-                "dim,method,evaluations,seconds,seconds_min,seconds_max,samples");
+                "dim,method,evaluations,seconds,seconds_min,seconds_max,samples,threads");
   const Eigen::Index rows = 32;
   for (const nn::Index dim : {2, 8, 12, 1568}) {
     nn::DynamicsConfig config;
@@ -99,7 +99,7 @@ void dimension_chart(const std::string& out, bool quick) {
 // (skipped where one pass would exceed `fd_budget` seconds).
 void parameter_chart(const std::string& out, bool quick) {
   CsvWriter csv(out + "/fd_time_params.csv",
-                "width,params,method,evaluations,seconds,seconds_min,seconds_max,samples");
+                "width,params,method,evaluations,seconds,seconds_min,seconds_max,samples,threads");
   const SpringData data = spring_data(25, 30, 0.1, /*seed=*/0);
   const double fd_budget = quick ? 0.5 : 4.0;
   for (const nn::Index width : {4, 8, 16, 32, 64, 128, 200}) {
