@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include "apps/hnn/commands.h"
+#include "apps/hnn/validators.h"
 #include "tasks/pixel_pendulum.h"
 #include "tasks/reversibility.h"
 
@@ -29,7 +30,7 @@ void add_bump_command(CLI::App& app) {
       ->check(CLI::Range(-1, 1000000))
       ->capture_default_str();
   cmd->add_option("--before", o->before, "Frames along S_H before the bump")
-      ->check(CLI::PositiveNumber)
+      ->check(positive_real())
       ->capture_default_str();
   cmd->add_option("--raise", o->raise,
                   "Rise of the learned H along R_H, as a fraction of its spread over the test "
@@ -38,10 +39,10 @@ void add_bump_command(CLI::App& app) {
   cmd->add_option("--riemann", o->riemann,
                   "Instead of --raise: this long along R_H (negative: along -R_H)");
   cmd->add_option("--after", o->after, "Frames along S_H after the bump")
-      ->check(CLI::PositiveNumber)
+      ->check(positive_real())
       ->capture_default_str();
   cmd->add_option("--dt", o->dt, "Output spacing in frames")
-      ->check(CLI::PositiveNumber)
+      ->check(positive_real())
       ->capture_default_str();
   cmd->add_option("--out", *out, "Folder for bump.csv, bump.gif, bump_strip.png (default RUN)");
   cmd->callback([=] {
@@ -104,9 +105,9 @@ void add_reversibility_command(CLI::App& app) {
       ->delimiter(',')
       ->capture_default_str();
   cmd->add_option("--t-end", o->t_end, "Span (default: the task's rollout span)")
-      ->check(CLI::PositiveNumber);
+      ->check(positive_real());
   cmd->add_option("--dt", o->dt, "Step of fixed-step methods (default span / 1000)")
-      ->check(CLI::PositiveNumber);
+      ->check(positive_real());
   cmd->add_option("--trajectories", o->trajectories, "Initial states")
       ->check(CLI::Range(1, 1000))
       ->capture_default_str();

@@ -232,12 +232,41 @@ TEST(ResumeOptions, ConflictsAndMissingCheckpointsGetOneLine) {
   EXPECT_EQ(none.err, fmt::format("hnn: error: no checkpoint in '{0}/checkpoint' (cannot read "
                                   "'{0}/checkpoint/state.json')\n",
                                   dir.path().string()));
-  const Result both =
-      run_hnn({"train", "--resume", dir.path().string(), "--model", "baseline"}, dir.path());
-  EXPECT_EQ(both.code, 1);
-  EXPECT_EQ(both.err,
-            "hnn: error: --model cannot be combined with --resume: a resumed run keeps its own "
-            "settings\n");
+  // Every setting of the run is refused next to --resume (the checkpoint's are used).
+  const std::vector<std::vector<std::string>> settings = {
+      {"--model", "baseline"}, {"--steps", "5"},  {"--seed", "2"}, {"--dtype", "float"},
+      {"--batch", "5"},        {"--hidden", "4"}, {"--lr", "0.1"}, {"--data", "x.txt"},
+      {"--out", "elsewhere"},  {"spring"}};
+  for (const std::vector<std::string>& setting : settings) {
+    std::vector<std::string> args = {"train", "--resume", dir.path().string()};
+    args.insert(args.end(), setting.begin(), setting.end());
+    const Result both = run_hnn(args, dir.path());
+    const std::string name = setting.size() == 1 ? "task" : setting[0];
+    EXPECT_EQ(both.code, 1) << name;
+    EXPECT_EQ(both.err, "hnn: error: " + name +
+                            " cannot be combined with --resume: a resumed run keeps its own "
+                            "settings\n");
+  }
+}
+
+// SIGTERM (a scheduler's stop) is handled as Ctrl-C: the step finishes, a complete checkpoint
+// is written and the way to resume is printed.
+TEST_F(ResumeCli, SigtermStopsLikeSigint) {
+  const fs::path run = dir_ / "run";
+  Child child(long_run(run, "1000"), dir_.path());
+  ASSERT_TRUE(wait_until([&] { return checkpoint_step(run) >= 1000; }, 60));
+  child.signal(SIGTERM);
+  const int status = child.wait();
+  ASSERT_TRUE(WIFEXITED(status)) << "killed by signal " << WTERMSIG(status);
+  EXPECT_EQ(WEXITSTATUS(status), 130);
+  const long step = checkpoint_step(run);
+  EXPECT_GT(step, 1000);
+  EXPECT_TRUE(child.err().ends_with(
+      fmt::format("hnn: training stopped at step {} of 30000; checkpoint in {}\n"
+                  "hnn: resume with: hnn train --resume {}\n",
+                  step, tasks::checkpoint_dir(run).string(), run.string())))
+      << child.err();
+  expect_complete_files(run);
 }
 
 // A loss that overflows (the baseline) and parameters that do (the HNN, whose loss stays finite
