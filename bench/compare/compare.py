@@ -1,0 +1,327 @@
+#!/usr/bin/python3
+"""hnn against PyTorch and LibTorch on the same training steps (bench/compare/README.md).
+
+Builds hnn_train_step (and libtorch_step, in its own folder, when LibTorch is installed),
+writes each task's data and hnn's initial parameters once, then runs every case with hnn,
+PyTorch and LibTorch alternating, for N rounds, at each thread count, in the tuned environment
+(OpenBLAS OpenMP build, OPENBLAS_CORETYPE, glibc malloc tunables). Prints a table of median
+ms/step and torch/hnn ratios and writes it as JSON and Markdown. A separate check trains the
+spring HNN for the full 2000 steps with all three on the reference data and compares the final
+losses. Uses only the standard library: run it with any python3; the PyTorch side runs under
+/usr/bin/python3 (Debian's python3-torch). Skips PyTorch or LibTorch (message, exit 0) when
+they are missing.
+"""
+import argparse
+import datetime
+import json
+import os
+import platform
+import statistics
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+ROOT = HERE.parent.parent
+OPENBLAS_OPENMP = "/usr/lib/x86_64-linux-gnu/openblas-openmp"
+MALLOC_TUNABLES = "glibc.malloc.mmap_threshold=16777216:glibc.malloc.trim_threshold=268435456"
+IMPLS = ("hnn", "pytorch", "libtorch")
+
+# name: (task, model, dtype, timing steps). Steps are short enough for a shared machine; the
+# spring loss check runs the full 2000 separately.
+CASES = {
+    "spring-hnn-f32": ("spring", "hnn", "float32", 400),
+    "spring-hnn-f64": ("spring", "hnn", "float64", 400),
+    "spring-baseline-f32": ("spring", "baseline", "float32", 400),
+    "twobody-hnn-f32": ("twobody", "hnn", "float32", 1000),
+    "twobody-hnn-f64": ("twobody", "hnn", "float64", 1000),
+    "twobody-baseline-f32": ("twobody", "baseline", "float32", 1000),
+    "threebody-hnn-f32": ("threebody", "hnn", "float32", 400),
+    "threebody-baseline-f32": ("threebody", "baseline", "float32", 400),
+    "pixel-hnn-f32": ("pixel", "hnn", "float32", 150),
+    "pixel-baseline-f32": ("pixel", "baseline", "float32", 150),
+}
+QUICK = ["spring-hnn-f32", "spring-hnn-f64", "twobody-hnn-f32", "threebody-hnn-f32",
+         "pixel-hnn-f32"]
+
+
+def log(*args):
+    print(*args, file=sys.stderr, flush=True)
+
+
+def tuned_env(args, threads):
+    env = dict(os.environ)
+    env.update(OPENBLAS_CORETYPE=args.coretype, OMP_NUM_THREADS=str(threads),
+               OPENBLAS_NUM_THREADS=str(threads), MKL_NUM_THREADS=str(threads),
+               GLIBC_TUNABLES=MALLOC_TUNABLES)
+    if Path(OPENBLAS_OPENMP).is_dir():
+        env["LD_LIBRARY_PATH"] = OPENBLAS_OPENMP + (
+            ":" + env["LD_LIBRARY_PATH"] if env.get("LD_LIBRARY_PATH") else "")
+    return env
+
+
+def sh(cmd, **kw):
+    log("+", " ".join(str(c) for c in cmd))
+    return subprocess.run([str(c) for c in cmd], **kw)
+
+
+# ---- building -----------------------------------------------------------------------------
+def build(args):
+    """hnn_train_step in build_dir; libtorch_step in build_dir/libtorch (None when absent)."""
+    b = Path(args.build_dir)
+    hnn = b / "bench" / "compare" / "hnn_train_step"
+    if not args.no_build:
+        if not (b / "CMakeCache.txt").exists():
+            sh(["nice", "cmake", "-S", ROOT, "-B", b, "-DCMAKE_BUILD_TYPE=Release",
+                "-DHNN_BUILD_TESTS=OFF"], check=True)
+        sh(["nice", "cmake", "--build", b, "-j2", "--target", "hnn_train_step"], check=True)
+    libtorch = b / "libtorch" / "libtorch_step"
+    if "libtorch" in args.impls and not args.no_build:
+        configured = sh(["nice", "cmake", "-S", HERE / "libtorch", "-B", b / "libtorch",
+                         "-DCMAKE_BUILD_TYPE=Release"], capture_output=True, text=True)
+        if configured.returncode != 0:
+            log("LibTorch not found (find_package(Torch) failed; Debian: libtorch-dev): skipping it")
+            return hnn, None
+        sh(["nice", "cmake", "--build", b / "libtorch", "-j2"], check=True)
+    return hnn, libtorch if libtorch.exists() else None
+
+
+def torch_available(args):
+    probe = subprocess.run([args.python, "-c", "import torch, numpy"], capture_output=True,
+                           env=tuned_env(args, 1))
+    if probe.returncode != 0:
+        log(f"PyTorch not importable by {args.python} (Debian: python3-torch): skipping it")
+    return probe.returncode == 0
+
+
+# ---- data and initial parameters -----------------------------------------------------------
+def run_json(cmd, env, timeout=None):
+    out = sh(cmd, env=env, capture_output=True, text=True, timeout=timeout)
+    if out.returncode != 0:
+        raise RuntimeError(f"{cmd[0]} failed ({out.returncode}): {out.stderr.strip()[-2000:]}")
+    lines = [l for l in out.stdout.splitlines() if l.startswith("{")]
+    if not lines:
+        raise RuntimeError(f"{cmd[0]} printed no JSON: {out.stderr.strip()[-2000:]}")
+    return json.loads(lines[-1])
+
+
+def prepare(args, hnn, cases, out):
+    """Per task the data file and its sizes; per case hnn's initial parameters."""
+    env = tuned_env(args, 1)
+    prep = out / "inputs"
+    prep.mkdir(parents=True, exist_ok=True)
+    data, inits = {}, {}
+    for name in cases:
+        task, model, dtype, _ = CASES[name]
+        if task not in data:
+            if task == "spring" and Path(args.spring_data).exists():
+                data[task] = {"path": str(Path(args.spring_data).resolve()), "n_train": 750,
+                              "n_test": 750}
+            else:
+                path = prep / f"{task}.f64"
+                r = run_json([hnn, "--task", task, "--steps", 2, "--warmup", 1, "--window", 1,
+                              "--save-data", path], env)
+                data[task] = {"path": str(path), "n_train": r["n_train"], "n_test": r["n_test"]}
+        init = prep / f"{task}-{model}-{dtype}.init"
+        d = data[task]
+        run_json([hnn, "--task", task, "--model", model, "--dtype", dtype, "--steps", 2,
+                  "--warmup", 1, "--window", 1, "--data", d["path"], "--n-train", d["n_train"],
+                  "--n-test", d["n_test"], "--save-init", init], env)
+        inits[name] = str(init)
+    return data, inits
+
+
+def command(impl, progs, args, case, data, init, threads, steps):
+    task, model, dtype, _ = CASES[case]
+    common = ["--task", task, "--model", model, "--dtype", dtype, "--threads", threads,
+              "--steps", steps, "--data", data["path"], "--n-train", data["n_train"],
+              "--n-test", data["n_test"]]
+    if impl == "hnn":
+        return [progs["hnn"]] + common
+    if impl == "pytorch":
+        return [args.python, HERE / "torch_step.py"] + common + ["--init", init]
+    return [progs["libtorch"]] + common + ["--init", init]
+
+
+# ---- the runs -----------------------------------------------------------------------------
+def time_cases(args, progs, cases, data, inits):
+    runs = []
+    impls = [i for i in IMPLS if i in progs]
+    for threads in args.threads:
+        env = tuned_env(args, threads)
+        for rnd in range(args.rounds):
+            for case in cases:
+                # Alternate, and rotate the order each round so no implementation always
+                # follows the same neighbour.
+                order = impls[rnd % len(impls):] + impls[:rnd % len(impls)]
+                steps = max(20, int(CASES[case][3] * args.steps_scale))
+                for impl in order:
+                    cmd = command(impl, progs, args, case, data[CASES[case][0]], inits[case],
+                                  threads, steps)
+                    load = os.getloadavg()[0]
+                    try:
+                        r = run_json(cmd, env, timeout=args.timeout)
+                    except (RuntimeError, subprocess.TimeoutExpired) as error:
+                        log(f"  {impl} {case}: {error}")
+                        continue
+                    r.update(case=case, round=rnd, load_before=load)
+                    runs.append(r)
+                    log(f"  {case:24s} t={threads} round {rnd} {impl:9s} "
+                        f"{r['ms_per_step']:9.3f} ms/step  train {r['train_loss']:.6g}  "
+                        f"load {load:.1f}")
+    return runs
+
+
+def loss_check(args, progs, data, out):
+    """Spring HNN, full 2000 steps, f32 and f64, each implementation once."""
+    if "spring" not in data:
+        return []
+    env = tuned_env(args, args.loss_threads)
+    checks = []
+    for dtype in ("float32", "float64"):
+        case = f"spring-hnn-{'f32' if dtype == 'float32' else 'f64'}"
+        init = out / "inputs" / f"spring-hnn-{dtype}.init"
+        if not init.exists():
+            continue
+        for impl in (i for i in IMPLS if i in progs):
+            cmd = command(impl, progs, args, case, data["spring"], str(init), args.loss_threads,
+                          2000)
+            try:
+                r = run_json(cmd, env, timeout=args.timeout * 5)
+            except (RuntimeError, subprocess.TimeoutExpired) as error:
+                log(f"  loss check {impl} {dtype}: {error}")
+                continue
+            log(f"  loss check {impl:9s} {dtype}: train {r['train_loss']:.6g} "
+                f"test {r['test_loss']:.6g}")
+            checks.append(r)
+    return checks
+
+
+# ---- the report ---------------------------------------------------------------------------
+def summarise(runs, cases, threads_list):
+    rows = []
+    for threads in threads_list:
+        for case in cases:
+            row = {"case": case, "threads": threads}
+            for impl in IMPLS:
+                mine = [r for r in runs if r["case"] == case and r["threads"] == threads
+                        and r["impl"] == impl]
+                if mine:
+                    row[impl] = {"ms": statistics.median(r["ms_per_step"] for r in mine),
+                                 "runs": [round(r["ms_per_step"], 4) for r in mine],
+                                 "train_loss": statistics.median(r["train_loss"] for r in mine),
+                                 "test_loss": statistics.median(r["test_loss"] for r in mine)}
+            if "hnn" in row:
+                for impl in ("pytorch", "libtorch"):
+                    if impl in row:
+                        row[f"{impl}/hnn"] = row[impl]["ms"] / row["hnn"]["ms"]
+            rows.append(row)
+    return rows
+
+
+def fmt_ms(row, impl):
+    return f"{row[impl]['ms']:.3f}" if impl in row else "-"
+
+
+def markdown(meta, rows, checks):
+    lines = [f"Measured {meta['date']} on {meta['cpu']} ({meta['cpus']} CPUs), hnn {meta['commit']};"
+             f" load average {meta['load_start']:.1f} at the start, {meta['load_end']:.1f} at the end;"
+             f" {meta['rounds']} rounds, medians; env: {meta['env']}.", "",
+             "| case | threads | hnn ms/step | PyTorch ms/step | LibTorch ms/step | PyTorch/hnn |"
+             " LibTorch/hnn | train loss hnn / PyTorch / LibTorch |",
+             "| --- | --- | --- | --- | --- | --- | --- | --- |"]
+    for row in rows:
+        ratio = lambda k: f"{row[k]:.2f}x" if k in row else "-"
+        losses = " / ".join(f"{row[i]['train_loss']:.4g}" if i in row else "-" for i in IMPLS)
+        lines.append(f"| {row['case']} | {row['threads']} | {fmt_ms(row, 'hnn')} | "
+                     f"{fmt_ms(row, 'pytorch')} | {fmt_ms(row, 'libtorch')} | "
+                     f"{ratio('pytorch/hnn')} | {ratio('libtorch/hnn')} | {losses} |")
+    if checks:
+        lines += ["", "Same computation: spring HNN, 2000 full-batch steps on "
+                  "spring_seed0.f64 from hnn's initial parameters (reference f32: train 0.0350,"
+                  " test 0.0404):", "", "| implementation | dtype | train loss | test loss |",
+                  "| --- | --- | --- | --- |"]
+        for c in checks:
+            lines.append(f"| {c['impl']} | {c['dtype']} | {c['train_loss']:.6g} | "
+                         f"{c['test_loss']:.6g} |")
+    return "\n".join(lines) + "\n"
+
+
+def machine(args):
+    cpu = platform.processor() or "unknown CPU"
+    try:
+        with open("/proc/cpuinfo") as f:
+            names = [l.split(":", 1)[1].strip() for l in f if l.startswith("model name")]
+        cpu = names[0] if names else cpu
+    except OSError:
+        pass
+    commit = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"],
+                            capture_output=True, text=True).stdout.strip() or "unknown"
+    dirty = subprocess.run(["git", "-C", ROOT, "status", "--porcelain", "--untracked-files=no"],
+                           capture_output=True, text=True).stdout.strip()
+    return {"date": datetime.datetime.now().strftime("%Y-%m-%d %H:%M"), "cpu": cpu,
+            "cpus": os.cpu_count(), "commit": commit + ("+local changes" if dirty else ""),
+            "load_start": os.getloadavg()[0], "rounds": args.rounds,
+            "env": f"OPENBLAS_CORETYPE={args.coretype}, openblas-openmp, malloc tunables"}
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--build-dir", default=str(ROOT / "build-compare"))
+    ap.add_argument("--out", default=str(HERE / "results"), help="results folder")
+    ap.add_argument("--rounds", type=int, default=3)
+    ap.add_argument("--threads", default="2,1", help="thread counts, e.g. 2,1")
+    ap.add_argument("--cases", default="all",
+                    help="comma-separated names, 'all' or 'quick': " + ", ".join(CASES))
+    ap.add_argument("--impls", default=",".join(IMPLS))
+    ap.add_argument("--steps-scale", type=float, default=1.0, help="scales the timing steps")
+    ap.add_argument("--spring-data", default="/work/shared/reference/spring_seed0.f64")
+    ap.add_argument("--coretype", default="Cooperlake", help="OPENBLAS_CORETYPE for the runs")
+    ap.add_argument("--python", default="/usr/bin/python3", help="interpreter with torch")
+    ap.add_argument("--timeout", type=float, default=900, help="seconds per timing run")
+    ap.add_argument("--no-build", action="store_true")
+    ap.add_argument("--no-loss-check", action="store_true")
+    ap.add_argument("--loss-threads", type=int, default=1,
+                    help="threads of the spring loss check (its figures are not timings)")
+    args = ap.parse_args()
+    args.threads = [int(t) for t in args.threads.split(",")]
+    args.impls = args.impls.split(",")
+    cases = (list(CASES) if args.cases == "all" else QUICK if args.cases == "quick"
+             else args.cases.split(","))
+    for c in cases:
+        if c not in CASES:
+            sys.exit(f"unknown case {c}; known: {', '.join(CASES)}")
+
+    meta = machine(args)
+    hnn, libtorch = build(args)
+    progs = {"hnn": hnn}
+    if "pytorch" in args.impls and torch_available(args):
+        progs["pytorch"] = None
+    if libtorch is not None and "libtorch" in args.impls:
+        progs["libtorch"] = libtorch
+    if len(progs) == 1:
+        log("Neither PyTorch nor LibTorch is available: nothing to compare against; skipping.")
+        return 0
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    data, inits = prepare(args, hnn, cases, out)
+    started = time.time()
+    runs = time_cases(args, progs, cases, data, inits)
+    checks = [] if args.no_loss_check else loss_check(args, progs, data, out)
+    meta.update(load_end=os.getloadavg()[0], minutes=(time.time() - started) / 60,
+                impls=[i for i in IMPLS if i in progs])
+    rows = summarise(runs, cases, args.threads)
+    report = markdown(meta, rows, checks)
+    stamp = datetime.datetime.now().strftime("%Y%m%d-%H%M%S")
+    result = {"meta": meta, "summary": rows, "loss_check": checks, "runs": runs}
+    for name in (f"compare-{stamp}", "latest"):
+        (out / f"{name}.json").write_text(json.dumps(result, indent=1) + "\n")
+        (out / f"{name}.md").write_text(report)
+    print(report)
+    log(f"written: {out}/compare-{stamp}.{{json,md}} and latest.{{json,md}}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,229 @@
+// hnn's side of the PyTorch / LibTorch comparison (bench/compare/README.md): trains one task's
+// model with the trainer's step (TapeScope, mse of time_derivative, grad, Adam) and prints one
+// JSON line with the median ms/step over timed windows and the final train/test losses.
+// Also writes the data and initial parameters that torch_step.py and libtorch_step load, so all
+// three run the same computation from the same start on the same batches (compare_common.h).
+
+#include <Eigen/Core>
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <random>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "autodiff/grad.h"
+#include "autodiff/ops.h"
+#include "autodiff/parallel.h"
+#include "autodiff/tape.h"
+#include "bench/compare/compare_common.h"
+#include "nn/hnn.h"
+#include "nn/loss.h"
+#include "nn/optim.h"
+#include "tasks/pixel_pendulum.h"
+#include "tasks/task.h"
+#include "tasks/trainer.h"
+
+namespace {
+
+namespace ad = hnn::ad;
+namespace nn = hnn::nn;
+namespace pixel = hnn::tasks::pixel;
+namespace cmp = hnn::compare;
+using nlohmann::json;
+
+constexpr double kHnnWeight = 0.1;  // pixel loss = ae + cc + 0.1 hnn
+
+// ---- data ---------------------------------------------------------------------------------
+
+using Batch = hnn::physics::Batch;
+
+cmp::Rows to_rows(const Batch& b) {
+  return {b.rows(), b.cols(), std::vector<double>(b.data(), b.data() + b.size())};
+}
+
+Batch to_batch(const cmp::Rows& r) {
+  return Eigen::Map<const Batch>(r.values.data(), r.rows, r.cols);
+}
+
+// The pairs of frames of rows [start, start + count) (next: their successors), as the pixel
+// trainer assembles them.
+Batch pixel_split(const pixel::PixelData& d, Eigen::Index start, Eigen::Index count, bool next) {
+  std::vector<Eigen::Index> rows(static_cast<std::size_t>(count));
+  for (Eigen::Index i = 0; i < count; ++i) rows[std::size_t(i)] = start + i;
+  return d.pairs_of<double>(rows, next);
+}
+
+// The task's own dataset (spring, two-body, three-body) or, for the pixel task, the pairs of
+// frames of PixelConfig's scene with `pixel_trials` trials (x = pair, target = next pair).
+cmp::Data build_data(const cmp::Options& o) {
+  if (o.task == "pixel") {
+    pixel::PixelConfig config;
+    config.trials = o.pixel_trials;
+    const pixel::PixelData d = pixel::build_pixel_data(config, o.seed);
+    const Eigen::Index n = d.train_rows(), t = d.test_rows;
+    return {to_rows(pixel_split(d, t, n, false)), to_rows(pixel_split(d, t, n, true)),
+            to_rows(pixel_split(d, 0, t, false)), to_rows(pixel_split(d, 0, t, true))};
+  }
+  const hnn::tasks::Dataset d =
+      hnn::tasks::make_task(cmp::task_name(o.task))->build_dataset(o.seed);
+  return {to_rows(d.train_x), to_rows(d.train_dxdt), to_rows(d.test_x), to_rows(d.test_dxdt)};
+}
+
+// ---- models -------------------------------------------------------------------------------
+
+// One model behind a common face: its parameters, its loss on a batch, its Adam groups.
+template <typename T>
+class Model {
+ public:
+  explicit Model(const cmp::Options& o) {
+    std::mt19937_64 rng(o.seed);
+    const nn::ModelKind kind = o.model == "hnn" ? nn::ModelKind::kHnn : nn::ModelKind::kBaseline;
+    if (o.task == "pixel") {
+      pixel::PixelConfig config;
+      pixel_ = std::make_unique<pixel::PixelModel<T>>(config, kind, rng);
+      for (const nn::NamedParameter<T>& p : pixel_->named_parameters()) {
+        named_.push_back(p);
+        (p.name.rfind("dynamics.", 0) == 0 ? dyn_ : ae_).push_back(p.var);
+      }
+    } else {
+      nn::DynamicsConfig config;
+      config.model = kind;
+      config.dim = cmp::task_dim(o.task);
+      dynamics_ = nn::make_model<T>(config, rng);
+      named_ = dynamics_->named_parameters();
+      for (const nn::NamedParameter<T>& p : named_) ae_.push_back(p.var);
+    }
+    params_ = ae_;
+    params_.insert(params_.end(), dyn_.begin(), dyn_.end());
+    // The pixel task's groups (PixelConfig): L2 on the autoencoder only.
+    adam_main_ = std::make_unique<nn::Adam<T>>(
+        ae_, nn::AdamOptions{.lr = o.lr, .weight_decay = o.weight_decay});
+    if (!dyn_.empty()) {
+      adam_dyn_ = std::make_unique<nn::Adam<T>>(
+          dyn_, nn::AdamOptions{.lr = o.lr, .weight_decay = o.dynamics_weight_decay});
+    }
+  }
+
+  /// The training loss of a batch, on the tape.
+  ad::Var<T> loss(const ad::Matrix<T>& x, const ad::Matrix<T>& dx) const {
+    if (pixel_) {
+      return ad::mean(
+          pixel::pixel_loss(*pixel_, ad::Var<T>::constant(x), ad::Var<T>::constant(dx), kHnnWeight)
+              .total);
+    }
+    return nn::mse(dynamics_->time_derivative(ad::Var<T>::constant(x)), ad::Var<T>::constant(dx));
+  }
+
+  /// One training step: the trainer's loop body.
+  void step(const ad::Matrix<T>& x, const ad::Matrix<T>& dx) {
+    ad::TapeScope scope;  // everything this step records is recycled at the closing brace
+    const ad::Var<T> l = loss(x, dx);
+    const std::vector<ad::Var<T>> grads = ad::grad<T>({l}, params_);
+    const auto split = std::ptrdiff_t(ae_.size());
+    if (adam_dyn_) {
+      adam_main_->step({grads.begin(), grads.begin() + split});
+      adam_dyn_->step({grads.begin() + split, grads.end()});
+    } else {
+      adam_main_->step(grads);
+    }
+  }
+
+  /// The mean loss over a whole split, without a graph (chunks of 1000 rows).
+  double mean_loss(const Batch& x, const Batch& dx) const {
+    if (!pixel_) return hnn::tasks::field_mse(*dynamics_, x, dx);
+    double total = 0;
+    for (Eigen::Index s = 0; s < x.rows(); s += 1000) {
+      const Eigen::Index n = std::min<Eigen::Index>(1000, x.rows() - s);
+      ad::TapeScope scope;
+      ad::NoGradGuard values_only;
+      const ad::Matrix<T> xs = x.middleRows(s, n).cast<T>(), dxs = dx.middleRows(s, n).cast<T>();
+      total += double(loss(xs, dxs).item()) * double(n);
+    }
+    return total / double(x.rows());
+  }
+
+  const std::vector<nn::NamedParameter<T>>& named_parameters() const { return named_; }
+
+ private:
+  std::unique_ptr<nn::DynamicsModel<T>> dynamics_;
+  std::unique_ptr<pixel::PixelModel<T>> pixel_;
+  std::vector<nn::NamedParameter<T>> named_;
+  std::vector<ad::Var<T>> ae_, dyn_, params_;
+  std::unique_ptr<nn::Adam<T>> adam_main_, adam_dyn_;
+};
+
+// Parameters in torch's layout (a Linear's weight out x in), float64, in hnn's order; and a JSON
+// manifest of names and shapes next to them.
+template <typename T>
+void save_init(const Model<T>& model, const std::string& path) {
+  std::ofstream out(path, std::ios::binary);
+  json manifest = json::array();
+  for (const nn::NamedParameter<T>& p : model.named_parameters()) {
+    const ad::Matrix<T>& v = p.var.value();
+    const bool weight = p.name.size() >= 6 && p.name.compare(p.name.size() - 6, 6, "weight") == 0;
+    // A weight is in x out here (y = x W); torch stores W^T. A bias is 1 x out in both.
+    const Batch torch_layout =
+        weight ? Batch(v.transpose().template cast<double>()) : Batch(v.template cast<double>());
+    cmp::write_rows(out, to_rows(torch_layout));
+    manifest.push_back(
+        {{"name", p.name}, {"shape", weight ? json{v.cols(), v.rows()} : json{v.cols()}}});
+  }
+  if (!out) throw std::runtime_error("cannot write " + path);
+  std::ofstream(path + ".json") << manifest.dump(1) << "\n";
+}
+
+// ---- the timed run ------------------------------------------------------------------------
+
+template <typename T>
+json run(const cmp::Options& o, const cmp::Data& data) {
+  Model<T> model(o);
+  if (!o.save_init.empty()) save_init(model, o.save_init);
+  const ad::Matrix<T> x = to_batch(data.train_x).cast<T>();
+  const ad::Matrix<T> dx = to_batch(data.train_dx).cast<T>();
+  const Eigen::Index batch = o.batch == 0 ? x.rows() : o.batch;
+  ad::Matrix<T> xb(batch, x.cols()), dxb(batch, dx.cols());
+  cmp::BatchIndices indices(o.seed, x.rows());
+  cmp::StepTimer timer(o.steps, o.warmup, o.window);
+  for (int step = 0; step < o.steps; ++step) {
+    if (o.batch == 0) {
+      model.step(x, dx);
+    } else {
+      for (Eigen::Index i = 0; i < batch; ++i) {
+        const Eigen::Index row = indices.next();
+        xb.row(i) = x.row(row);
+        dxb.row(i) = dx.row(row);
+      }
+      model.step(xb, dxb);
+    }
+    timer.tick(step + 1);
+  }
+  json result = timer.to_json();
+  result["train_loss"] = model.mean_loss(to_batch(data.train_x), to_batch(data.train_dx));
+  result["test_loss"] = model.mean_loss(to_batch(data.test_x), to_batch(data.test_dx));
+  return result;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    const cmp::Options o = cmp::parse_options(argc, argv, "hnn_train_step");
+    ad::set_num_threads(o.threads);
+    Eigen::setNbThreads(o.threads);
+    const cmp::Data data = o.data.empty() ? build_data(o) : cmp::load_data(o);
+    if (!o.save_data.empty()) cmp::save_data(data, o.save_data);
+    json result = o.dtype == "float32" ? run<float>(o, data) : run<double>(o, data);
+    cmp::add_run_fields(result, o, "hnn", data);
+    result["ad_threads"] = ad::num_threads();
+    result["init"] = "hnn, seed " + std::to_string(o.seed);
+    std::printf("%s\n", result.dump().c_str());
+    return 0;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "hnn_train_step: %s\n", e.what());
+    return 1;
+  }
+}
