@@ -116,7 +116,10 @@ def draw_latent_panel(ax, grid, paths, model, title):
     zq, zp = grid["z_q"].reshape(n, n), grid["z_p"].reshape(n, n)
     h = grid["learned_h"].reshape(n, n)
     if np.all(np.isfinite(h)):
-        contour = ax.contourf(zq, zp, h, levels=20, cmap="viridis")
+        # Levels at quantiles of H over the grid: H grows fast towards the corners, and evenly
+        # spaced levels would leave the encoded trajectories only a few rings.
+        levels = np.unique(np.quantile(h, np.linspace(0, 1, 21)))
+        contour = ax.contourf(zq, zp, h, levels=levels, cmap="viridis")
         plt.colorbar(contour, ax=ax, label="learned H")
     else:  # the baseline learns no H: its field instead
         ax.streamplot(zq[:, 0], zp[0, :], grid["dz_q"].reshape(n, n).T,
