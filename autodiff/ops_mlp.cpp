@@ -11,12 +11,23 @@
 #include <bit>
 #include <utility>
 
+#include "autodiff/gemm.h"
 #include "autodiff/mlp_ops.h"
 #include "autodiff/op_builder.h"
 #include "autodiff/ops.h"
 #include "autodiff/parallel.h"
 
 namespace hnn::ad {
+
+void detail::init_gemm() {
+#ifdef HNN_HAVE_OPENBLAS
+  static const bool once = [] {
+    openblas_set_num_threads(1);
+    return true;
+  }();
+  (void)once;
+#endif
+}
 
 namespace {
 
@@ -95,7 +106,7 @@ void hidden_rows(const Layers<T>& l, std::vector<Matrix<T>>& h, RowBlock r) {
     auto out = h[std::size_t(k - 1)].middleRows(r.begin, r.size());
     const auto in = k == 1 ? l.x().middleRows(r.begin, r.size())
                            : std::as_const(h[std::size_t(k - 2)]).middleRows(r.begin, r.size());
-    out.noalias() = in * l.w(k);
+    detail::gemm(in, false, l.w(k), false, out);
     if (const Var<T>* b = l.bias(k)) out.rowwise() += b->value().row(0);
     tanh_in_place(out);
   }
@@ -192,14 +203,16 @@ void tanh_mlp_backward(const Node<T>& n, const Var<T>& g, GradSink<T>& s) {
     for (int k = l.count; k >= 1; --k) {
       const auto prev = k == 1 ? l.x().middleRows(r.begin, r.size())
                                : n.buffers[std::size_t(k - 2)].middleRows(r.begin, r.size());
-      w.dw[std::size_t(k)].noalias() = prev.transpose() * *delta;
+      w.dw[std::size_t(k)].resize(prev.cols(), delta->cols());
+      detail::gemm(prev, true, *delta, false, w.dw[std::size_t(k)]);
       if (l.bias_input(k) >= 0) w.db[std::size_t(k)] = delta->colwise().sum();
       if (k > 1) {
-        next->noalias() = *delta * l.w(k).transpose();
+        next->resize(delta->rows(), l.w(k).rows());
+        detail::gemm(*delta, false, l.w(k), true, *next);
         next->array() *= T(1) - prev.array().square();
         std::swap(delta, next);
       } else if (dx) {
-        dx->middleRows(r.begin, r.size()).noalias() = *delta * l.w(1).transpose();
+        detail::gemm(*delta, false, l.w(1), true, dx->middleRows(r.begin, r.size()));
       }
     }
   });
@@ -277,8 +290,10 @@ void input_gradient_backward(const Node<T>& n, const Var<T>& g, GradSink<T>& s) 
     *abar = g.value().middleRows(r.begin, r.size());
     for (int k = 1; k < L; ++k) {  // up the gradient chain
       const auto hk = block(at.h(k));
-      dbar->noalias() = *abar * l.w(k);
-      w.dw[std::size_t(k)].noalias() = abar->transpose() * block(at.d(k));
+      dbar->resize(abar->rows(), l.w(k).cols());
+      detail::gemm(*abar, false, l.w(k), false, *dbar);
+      w.dw[std::size_t(k)].resize(abar->cols(), l.w(k).cols());
+      detail::gemm(*abar, true, block(at.d(k)), false, w.dw[std::size_t(k)]);
       w.hbar[std::size_t(k)] =
           (T(-2) * hk.array() * block(at.a(k)).array() * dbar->array()).matrix();
       dbar->array() *= T(1) - hk.array().square();
@@ -289,13 +304,13 @@ void input_gradient_backward(const Node<T>& n, const Var<T>& g, GradSink<T>& s) 
     for (int k = L - 1; k >= 1; --k) {  // down the forward chain; zbar_k in place of hbar_k
       hb->array() *= T(1) - block(at.h(k)).array().square();
       const auto prev = k == 1 ? l.x().middleRows(r.begin, r.size()) : block(at.h(k - 1));
-      w.dw[std::size_t(k)].noalias() += prev.transpose() * *hb;
+      detail::gemm(prev, true, *hb, false, w.dw[std::size_t(k)], T(1));
       if (l.bias_input(k) >= 0) w.db[std::size_t(k)] = hb->colwise().sum();
       if (k > 1) {
-        w.hbar[std::size_t(k - 1)].noalias() += *hb * l.w(k).transpose();
+        detail::gemm(*hb, false, l.w(k), true, w.hbar[std::size_t(k - 1)], T(1));
         hb = &w.hbar[std::size_t(k - 1)];
       } else if (dx_node) {
-        dx_node->value.middleRows(r.begin, r.size()).noalias() = *hb * l.w(1).transpose();
+        detail::gemm(*hb, false, l.w(1), true, dx_node->value.middleRows(r.begin, r.size()));
       }
     }
   });
@@ -308,6 +323,7 @@ void input_gradient_backward(const Node<T>& n, const Var<T>& g, GradSink<T>& s) 
 template <typename T>
 Var<T> tanh_mlp(const Var<T>& x, const std::vector<Var<T>>& weights,
                 const std::vector<Var<T>>& biases) {
+  detail::init_gemm();
   unsigned mask = 0;
   const auto inputs = gather("tanh_mlp", x, weights, biases, /*last_bias=*/true, mask);
   Node<T>& node = detail::record<T>("tanh_mlp", inputs, tanh_mlp_backward<T>);
@@ -325,10 +341,10 @@ Var<T> tanh_mlp(const Var<T>& x, const std::vector<Var<T>>& weights,
     const int L = l.count;
     auto out = node.value.middleRows(r.begin, r.size());
     if (L == 1) {
-      out.noalias() = l.x().middleRows(r.begin, r.size()) * l.w(1);
+      detail::gemm(l.x().middleRows(r.begin, r.size()), false, l.w(1), false, out);
     } else {
-      out.noalias() =
-          std::as_const(node.buffers[std::size_t(L - 2)]).middleRows(r.begin, r.size()) * l.w(L);
+      detail::gemm(std::as_const(node.buffers[std::size_t(L - 2)]).middleRows(r.begin, r.size()),
+                   false, l.w(L), false, out);
     }
     if (const Var<T>* b = l.bias(L)) out.rowwise() += b->value().row(0);
   });
@@ -338,6 +354,7 @@ Var<T> tanh_mlp(const Var<T>& x, const std::vector<Var<T>>& weights,
 template <typename T>
 Var<T> tanh_mlp_input_gradient(const Var<T>& x, const std::vector<Var<T>>& weights,
                                const std::vector<Var<T>>& biases) {
+  detail::init_gemm();
   unsigned mask = 0;
   const auto inputs =
       gather("tanh_mlp_input_gradient", x, weights, biases, /*last_bias=*/false, mask);
@@ -371,9 +388,11 @@ Var<T> tanh_mlp_input_gradient(const Var<T>& x, const std::vector<Var<T>>& weigh
     for (int k = L - 1; k >= 1; --k) {
       block(at.d(k)).array() = block(at.a(k)).array() * (T(1) - block(at.h(k)).array().square());
       if (k > 1) {
-        block(at.a(k - 1)).noalias() = block(at.d(k)) * l.w(k).transpose();
+        detail::gemm(std::as_const(node.buffers[at.d(k)]).middleRows(r.begin, r.size()), false,
+                     l.w(k), true, block(at.a(k - 1)));
       } else {
-        out.noalias() = block(at.d(k)) * l.w(k).transpose();
+        detail::gemm(std::as_const(node.buffers[at.d(k)]).middleRows(r.begin, r.size()), false,
+                     l.w(k), true, out);
       }
     }
   });

@@ -1,6 +1,7 @@
 // One full-batch training step of the paper's models on the mass-spring task (750 x 2 inputs,
 // 2-200-200-out tanh MLP): forward, the HNN's inner gradient, loss, parameter gradients and
-// Adam, in float and double. Also the learned field's evaluation, as rollouts call it.
+// Adam, in float and double, on 1 and 2 threads (wall time: the workers' CPU time is not the
+// caller's). Also the learned field's evaluation, as rollouts call it.
 
 #include <benchmark/benchmark.h>
 
@@ -38,6 +39,7 @@ Data spring_data() {
 
 template <typename T>
 void training_step(benchmark::State& state, nn::ModelKind kind) {
+  ad::set_num_threads(int(state.range(0)));
   const Data data = spring_data();
   nn::DynamicsConfig config;  // the paper's: 2-200-200-out, tanh, orthogonal
   config.model = kind;
@@ -74,16 +76,47 @@ void BM_HnnField(benchmark::State& state) {
   std::mt19937_64 rng(1);
   const nn::Hnn<T> model(nn::DynamicsConfig{}, rng);
   const nn::Matrix<T> x = data.x.cast<T>();
+  ad::set_num_threads(int(state.range(0)));
   for (auto _ : state) benchmark::DoNotOptimize(model.field(x));
 }
 
 }  // namespace
 
-BENCHMARK(BM_HnnStep<float>)->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_HnnStep<double>)->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_BaselineStep<float>)->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_BaselineStep<double>)->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_HnnField<float>)->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_HnnField<double>)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_HnnStep<float>)
+    ->Unit(benchmark::kMillisecond)
+    ->ArgName("threads")
+    ->Arg(1)
+    ->Arg(2)
+    ->UseRealTime();
+BENCHMARK(BM_HnnStep<double>)
+    ->Unit(benchmark::kMillisecond)
+    ->ArgName("threads")
+    ->Arg(1)
+    ->Arg(2)
+    ->UseRealTime();
+BENCHMARK(BM_BaselineStep<float>)
+    ->Unit(benchmark::kMillisecond)
+    ->ArgName("threads")
+    ->Arg(1)
+    ->Arg(2)
+    ->UseRealTime();
+BENCHMARK(BM_BaselineStep<double>)
+    ->Unit(benchmark::kMillisecond)
+    ->ArgName("threads")
+    ->Arg(1)
+    ->Arg(2)
+    ->UseRealTime();
+BENCHMARK(BM_HnnField<float>)
+    ->Unit(benchmark::kMillisecond)
+    ->ArgName("threads")
+    ->Arg(1)
+    ->Arg(2)
+    ->UseRealTime();
+BENCHMARK(BM_HnnField<double>)
+    ->Unit(benchmark::kMillisecond)
+    ->ArgName("threads")
+    ->Arg(1)
+    ->Arg(2)
+    ->UseRealTime();
 
 BENCHMARK_MAIN();
