@@ -88,8 +88,11 @@ def build(args):
 
 
 def torch_available(args):
-    probe = subprocess.run([args.python, "-c", "import torch, numpy"], capture_output=True,
-                           env=tuned_env(args, 1))
+    try:
+        probe = subprocess.run([args.python, "-c", "import torch, numpy"], capture_output=True,
+                               env=tuned_env(args, 1))
+    except OSError:  # no such interpreter
+        probe = subprocess.CompletedProcess(args.python, 1)
     if probe.returncode != 0:
         log(f"PyTorch not importable by {args.python} (Debian: python3-torch): skipping it")
     return probe.returncode == 0
