@@ -1,19 +1,47 @@
 // Matrix products, the fused linear layer, and transpose.
 
+#include "autodiff/gemm.h"
 #include "autodiff/op_builder.h"
 #include "autodiff/ops.h"
+#include "autodiff/parallel.h"
 
 namespace hnn::ad {
 
 namespace {
 
-// out = op(a) op(b) without materialising a transpose.
+// out = op(a) op(b) without materialising a transpose, through the fused kernels' GEMM, with
+// the output's rows (or, for a short wide output, its columns) split over the engine's threads.
 template <typename T>
 void product(const Matrix<T>& a, const Matrix<T>& b, bool ta, bool tb, Matrix<T>& out) {
-  if (!ta && !tb) out.noalias() = a * b;
-  if (!ta && tb) out.noalias() = a * b.transpose();
-  if (ta && !tb) out.noalias() = a.transpose() * b;
-  if (ta && tb) out.noalias() = a.transpose() * b.transpose();
+  detail::init_gemm();
+  const Eigen::Index m = ta ? a.cols() : a.rows(), n = tb ? b.rows() : b.cols();
+  out.resize(m, n);
+  if ((ta ? a.rows() : a.cols()) == 0) {
+    out.setZero();
+    return;
+  }
+  const bool by_rows = m >= n;
+  const int parts = parts_for(by_rows ? m : n);
+  parallel_for(parts, [&](int p) {
+    const RowBlock r = row_block(by_rows ? m : n, parts, p);
+    if (by_rows) {
+      const auto rows = [&](const auto& lhs) {
+        detail::gemm(lhs, ta, b, tb, out.middleRows(r.begin, r.size()));
+      };
+      if (ta)
+        rows(a.middleCols(r.begin, r.size()));
+      else
+        rows(a.middleRows(r.begin, r.size()));
+    } else {
+      const auto cols = [&](const auto& rhs) {
+        detail::gemm(a, ta, rhs, tb, out.middleCols(r.begin, r.size()));
+      };
+      if (tb)
+        cols(b.middleRows(r.begin, r.size()));
+      else
+        cols(b.middleCols(r.begin, r.size()));
+    }
+  });
 }
 
 // C = A' B' with A' = op(A), B' = op(B): dA' = G B'^T, dB' = A'^T G, transposed back when the
@@ -67,14 +95,14 @@ Var<T> linear(const Var<T>& x, const Var<T>& w, const Var<T>& b) {
   }
   Node<T>& node = b.defined() ? detail::record<T>("linear", {x, w, b}, linear_backward<T>)
                               : detail::record<T>("linear", {x, w}, linear_backward<T>);
-  node.value.noalias() = x.value() * w.value();
+  product<T>(x.value(), w.value(), false, false, node.value);
   if (b.defined()) node.value.rowwise() += b.value().row(0);
   return Var<T>::of(node);
 }
 
-#define HNN_INSTANTIATE(T)                                            \
-  template Var<T> matmul(const Var<T>&, const Var<T>&, bool, bool);   \
-  template Var<T> transpose(const Var<T>&);                           \
+#define HNN_INSTANTIATE(T)                                          \
+  template Var<T> matmul(const Var<T>&, const Var<T>&, bool, bool); \
+  template Var<T> transpose(const Var<T>&);                         \
   template Var<T> linear(const Var<T>&, const Var<T>&, const Var<T>&);
 HNN_INSTANTIATE(float)
 HNN_INSTANTIATE(double)

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <fstream>
 
+#include "autodiff/parallel.h"
 #include "nn/checkpoint.h"
 #include "physics/integrator.h"
 #include "tasks/files.h"
@@ -260,7 +261,7 @@ json run_pixel_training(const RunOptions& o, PixelConfig config) {
                   "--dtype must be float or double, got '{}'", o.dtype);
   HNN_TASKS_CHECK(o.data_file.empty(), "pixel-pendulum renders its own frames: no --data");
   HNN_TASKS_CHECK(!o.out.empty(), "an output folder is required");
-  Eigen::setNbThreads(o.threads);
+  ad::set_num_threads(o.threads);  // the fused kernels' row blocks
   const auto start = std::chrono::steady_clock::now();
   const PixelData data = build_pixel_data(config, o.seed);
   const double data_seconds = seconds_since(start);

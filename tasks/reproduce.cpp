@@ -23,7 +23,7 @@ using nlohmann::json;
 namespace {
 
 const char* const kModels[] = {"baseline", "hnn"};
-const char* const kAveraged[] = {"train_loss", "train_loss_se", "test_loss", "test_loss_se",
+const char* const kAveraged[] = {"train_loss", "train_loss_se", "test_loss",     "test_loss_se",
                                  "energy_mse", "energy_mse_se", "train_seconds", "eval_seconds"};
 
 fs::path run_dir(const ReproduceOptions& o, const std::string& task, const std::string& model,
@@ -44,13 +44,14 @@ std::vector<json> run_all(const std::vector<RunOptions>& runs, int jobs) {
       try {
         results[i] = run_training(runs[i]);
         const std::lock_guard lock(print);
-        fmt::print(stderr, "  {:<14} {:<9} seed {}  test loss {:.4e}  energy MSE {}  ({:.1f} s)\n",
-                   runs[i].task, runs[i].model, runs[i].seed,
-                   results[i]["test_loss"].is_number() ? results[i]["test_loss"].get<double>() : NAN,
-                   results[i]["energy_mse"].is_number()
-                       ? fmt::format("{:.4e}", results[i]["energy_mse"].get<double>())
-                       : "n/a",
-                   results[i]["train_seconds"].get<double>());
+        fmt::print(
+            stderr, "  {:<14} {:<9} seed {}  test loss {:.4e}  energy MSE {}  ({:.1f} s)\n",
+            runs[i].task, runs[i].model, runs[i].seed,
+            results[i]["test_loss"].is_number() ? results[i]["test_loss"].get<double>() : NAN,
+            results[i]["energy_mse"].is_number()
+                ? fmt::format("{:.4e}", results[i]["energy_mse"].get<double>())
+                : "n/a",
+            results[i]["train_seconds"].get<double>());
       } catch (...) {
         errors[i] = std::current_exception();
       }
@@ -134,10 +135,11 @@ std::string table1_markdown(const json& rows, double wall_seconds) {
                       both("paper_test_loss"), both("paper_energy_mse"));
   }
   if (by_task.count(pixel::kTaskName)) {
-    md += "\nPixel pendulum: losses are the combined ae + cc + 0.1 hnn per frame pair; energy MSE "
-          "is between the true Gym state's energy and the energy of the angle and velocity "
-          "recovered from the decoded frames of 200-frame latent rollouts (dopri5) from the test "
-          "trials (see energy_mse_frames_floor in its metrics.json for the recovery's own error).\n";
+    md +=
+        "\nPixel pendulum: losses are the combined ae + cc + 0.1 hnn per frame pair; energy MSE "
+        "is between the true Gym state's energy and the energy of the angle and velocity "
+        "recovered from the decoded frames of 200-frame latent rollouts (dopri5) from the test "
+        "trials (see energy_mse_frames_floor in its metrics.json for the recovery's own error).\n";
   }
   md += fmt::format("\nWall time of the whole reproduction: {:.1f} s.\n", wall_seconds);
   return md;
@@ -154,6 +156,7 @@ json reproduce(const ReproduceOptions& o) {
       for (int seed = 0; seed < o.seeds; ++seed) {
         RunOptions r{.task = task, .model = model, .seed = std::uint64_t(seed), .dtype = o.dtype};
         r.steps = o.steps;
+        r.threads = std::max(1, int(std::thread::hardware_concurrency()) / o.jobs);
         r.out = run_dir(o, task, model, seed);
         r.quiet = true;
         runs.push_back(r);

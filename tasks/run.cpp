@@ -7,6 +7,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "autodiff/parallel.h"
 #include "nn/checkpoint.h"
 #include "nn/hnn.h"
 #include "tasks/evaluate.h"
@@ -94,16 +95,11 @@ json evaluate_model(const Task& task, const Dataset& data, const nn::DynamicsMod
   const Batch x0 = task.rollout_states(data, rng);
   const Rollouts rollouts = make_rollouts(task, model, x0, task.rollout_config());
   const nn::MeanStderr energy = energy_mse(rollouts);
-  json m = {{"train_loss", number(train.mean)},
-            {"train_loss_se", number(train.std_error)},
-            {"test_loss", number(test.mean)},
-            {"test_loss_se", number(test.std_error)},
-            {"energy_mse", number(energy.mean)},
-            {"energy_mse_se", number(energy.std_error)},
-            {"n_rollouts", energy.count},
-            {"rollout_failures", rollouts.failures},
-            {"n_train", data.train_x.rows()},
-            {"n_test", data.test_x.rows()}};
+  json m = {{"train_loss", number(train.mean)},  {"train_loss_se", number(train.std_error)},
+            {"test_loss", number(test.mean)},    {"test_loss_se", number(test.std_error)},
+            {"energy_mse", number(energy.mean)}, {"energy_mse_se", number(energy.std_error)},
+            {"n_rollouts", energy.count},        {"rollout_failures", rollouts.failures},
+            {"n_train", data.train_x.rows()},    {"n_test", data.test_x.rows()}};
   m["eval_seconds"] = seconds_since(start);
   if (write_files) write_file_atomic(out / "rollout.csv", rollout_csv(rollouts));
   return m;
@@ -143,7 +139,8 @@ json train_and_evaluate(const Task& task, const Dataset& data, const RunOptions&
   const auto model_d = nn::cast_model<double>(*model);
   json metrics = evaluate_model(task, data, *model_d, o.seed, o.out, true);
   metrics["train_seconds"] = trained.seconds;
-  metrics["final_batch_loss"] = number(trained.curve.empty() ? NAN : trained.curve.back().train_loss);
+  metrics["final_batch_loss"] =
+      number(trained.curve.empty() ? NAN : trained.curve.back().train_loss);
   return metrics;
 }
 
@@ -200,7 +197,7 @@ void validate(const RunOptions& o) {
 json run_training(const RunOptions& o) {
   validate(o);
   if (o.task == pixel::kTaskName) return pixel::run_pixel_training(o);  // frames, not fields
-  Eigen::setNbThreads(o.threads);
+  ad::set_num_threads(o.threads);  // the fused kernels' row blocks
   const std::unique_ptr<Task> task = open_task(o.task, o.data_file);
   const TrainConfig config = resolve_config(*task, o);
   const auto start = std::chrono::steady_clock::now();

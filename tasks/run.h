@@ -25,7 +25,7 @@ struct RunOptions {
   std::string model = "hnn";    // hnn | baseline
   std::uint64_t seed = 0;
   std::string dtype = "double";  // float | double
-  int threads = 1;
+  int threads = 2;  // the engine's threads: fused kernels split each batch into row blocks
   std::optional<int> steps, batch_size;
   std::optional<std::vector<int>> hidden;
   std::optional<double> learning_rate;

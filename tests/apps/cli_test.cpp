@@ -145,7 +145,7 @@ TEST(CliTrain, ShortRunWritesTheRunFolderAndPrintsItsMetrics) {
   EXPECT_EQ(m["steps"], 20);
   EXPECT_EQ(m["hidden"], "16-16");
   EXPECT_EQ(m["dtype"], "double");
-  EXPECT_EQ(m["threads"], 1);  // the default
+  EXPECT_EQ(m["threads"], 2);  // the default: both cores
   for (const char* key : {"seed", "train_loss", "train_loss_se", "test_loss", "test_loss_se",
                           "energy_mse", "energy_mse_se", "train_seconds"}) {
     ASSERT_TRUE(m.contains(key)) << key;
