@@ -298,6 +298,13 @@ def main():
 
     meta = machine(args)
     hnn, libtorch = build(args)
+    # Which BLAS each C++ program resolves in the runs' environment (Note: LD_LIBRARY_PATH picks
+    # the OpenMP OpenBLAS over a linked pthreads one unless an RPATH says otherwise).
+    for name, prog in (("hnn_blas", hnn), ("libtorch_blas", libtorch)):
+        if prog is not None:
+            ldd = subprocess.run(["ldd", prog], capture_output=True, text=True,
+                                 env=tuned_env(args, 1)).stdout
+            meta[name] = [l.strip() for l in ldd.splitlines() if "blas" in l.lower()]
     progs = {"hnn": hnn}
     if "pytorch" in args.impls and torch_available(args):
         progs["pytorch"] = None
