@@ -12,6 +12,9 @@
 
 namespace hnn::ad::detail {
 
+/// Output widths below this go through gemm's narrow path.
+inline constexpr Eigen::Index kNarrow = 16;
+
 /// Call once before the first gemm: OpenBLAS must not start threads of its own.
 void init_gemm();
 
@@ -24,12 +27,24 @@ void gemm(const A& a, bool ta, const B& b, bool tb, C&& c, typename A::Scalar be
                (tb ? b.cols() : b.rows()) == k);
 #ifdef HNN_HAVE_OPENBLAS
   const auto op = [](bool t) { return t ? CblasTrans : CblasNoTrans; };
-  const int lda = int(a.outerStride()), ldb = int(b.outerStride()), ldc = int(c.outerStride());
+  const int lda = int(a.outerStride()), ldc = int(c.outerStride());
+  int ldb = int(b.outerStride());
+  const T* b_data = b.data();
+  if (!ta && !tb && n < kNarrow) {
+    // OpenBLAS 0.3.21's small-matrix kernel for A B with a narrow B (an MLP's last layer)
+    // mallocs on every call; A (B^T)^T takes another path, and B^T costs at most kNarrow x k.
+    thread_local Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> b_t;
+    b_t.resize(n, k);  // reallocates only when the shape changes
+    b_t = b.transpose();
+    b_data = b_t.data();
+    ldb = int(k);
+    tb = true;
+  }
   if constexpr (std::is_same_v<T, float>) {
     cblas_sgemm(CblasRowMajor, op(ta), op(tb), int(m), int(n), int(k), 1.0f, a.data(), lda,
-                b.data(), ldb, beta, c.data(), ldc);
+                b_data, ldb, beta, c.data(), ldc);
   } else {
-    cblas_dgemm(CblasRowMajor, op(ta), op(tb), int(m), int(n), int(k), 1.0, a.data(), lda, b.data(),
+    cblas_dgemm(CblasRowMajor, op(ta), op(tb), int(m), int(n), int(k), 1.0, a.data(), lda, b_data,
                 ldb, beta, c.data(), ldc);
   }
 #else

@@ -1,6 +1,8 @@
 #include "autodiff/grad.h"
 
 #include <algorithm>
+#include <memory>
+#include <span>
 #include <utility>
 
 #include "autodiff/ops.h"
@@ -13,16 +15,60 @@ namespace {
 
 thread_local std::uint64_t g_sweep_id = 0;
 
+// A sweep's working lists, kept per thread so that repeated sweeps allocate nothing. Sweeps can
+// nest (a backward formula may call grad), hence a stack of them.
+template <typename T>
+struct SweepBuffers {
+  std::vector<Node<T>*> order, leaves, targets;
+  std::vector<Var<T>> grads;
+  std::vector<std::pair<Node<T>*, std::size_t>> stack;
+};
+
+template <typename T>
+class BorrowedBuffers {
+ public:
+  BorrowedBuffers() {
+    if (depth() == pool().size()) pool().push_back(std::make_unique<SweepBuffers<T>>());
+    buffers_ = pool()[depth()++].get();
+  }
+  ~BorrowedBuffers() {
+    buffers_->grads.clear();  // drop references to nodes (capacity stays)
+    --depth();
+  }
+  SweepBuffers<T>& operator*() { return *buffers_; }
+
+ private:
+  static std::vector<std::unique_ptr<SweepBuffers<T>>>& pool() {
+    thread_local std::vector<std::unique_ptr<SweepBuffers<T>>> buffers;
+    return buffers;
+  }
+  static std::size_t& depth() {
+    thread_local std::size_t in_use = 0;
+    return in_use;
+  }
+  SweepBuffers<T>* buffers_;
+};
+
 // One reverse sweep: finds the nodes between the outputs and the targets, then propagates
 // gradients through them in reverse creation order (a reverse topological order).
 template <typename T>
 class Sweep : public GradSink<T> {
  public:
   // targets: the nodes whose gradients are wanted; all_leaves: every leaf is a target.
-  Sweep(const std::vector<Node<T>*>& targets, bool all_leaves)
-      : id_(++g_sweep_id), targets_(targets), all_leaves_(all_leaves) {}
+  Sweep(SweepBuffers<T>& buffers, bool all_leaves)
+      : id_(++g_sweep_id),
+        targets_(buffers.targets),
+        all_leaves_(all_leaves),
+        order_(buffers.order),
+        leaves_(buffers.leaves),
+        grads_(buffers.grads),
+        stack_(buffers.stack) {
+    order_.clear();
+    leaves_.clear();
+    grads_.clear();
+  }
 
-  void run(const std::vector<Var<T>>& outputs, const std::vector<Var<T>>& grad_outputs,
+  void run(std::span<const Var<T>> outputs, std::span<const Var<T>> grad_outputs,
            bool create_graph) {
     for (const Var<T>& out : outputs) visit(&out.node());
     std::sort(order_.begin(), order_.end(),
@@ -39,9 +85,7 @@ class Sweep : public GradSink<T> {
                      "grad: grad_outputs[{}] is {} but output {} is {}", k, grad_outputs[k].shape(),
                      k, shape_str(out.value.rows(), out.value.cols()));
       }
-      accumulate(out.slot,
-                 given ? grad_outputs[k]
-                       : Var<T>::constant(Matrix<T>::Ones(out.value.rows(), out.value.cols())));
+      accumulate(out.slot, given ? grad_outputs[k] : ones(out.value.rows(), out.value.cols()));
     }
     for (Node<T>* node : order_) {
       if (!grads_[node->slot].defined()) continue;
@@ -52,6 +96,14 @@ class Sweep : public GradSink<T> {
       for (int i = 0; i < int(node->inputs.size()); ++i) feeds_needed = feeds_needed || wants(i);
       if (feeds_needed) node->backward(*node, grads_[node->slot], *this);
     }
+  }
+
+  // The default seed, filled in place in a recycled tape node (no temporary matrix).
+  static Var<T> ones(Eigen::Index rows, Eigen::Index cols) {
+    Node<T>& node = Tape<T>::current().push();
+    node.op = "ones";
+    node.value.setOnes(rows, cols);
+    return Var<T>::of(node);
   }
 
   /// The gradient reaching `node` (undefined when none does).
@@ -88,7 +140,8 @@ class Sweep : public GradSink<T> {
   // "needed") when it is a target or some input of it is needed.
   void visit(Node<T>* root) {
     if (!root->requires_grad || root->sweep == id_) return;
-    std::vector<std::pair<Node<T>*, std::size_t>> stack;
+    std::vector<std::pair<Node<T>*, std::size_t>>& stack = stack_;
+    stack.clear();
     root->sweep = id_;
     root->slot = -1;
     stack.push_back({root, 0});
@@ -124,9 +177,10 @@ class Sweep : public GradSink<T> {
   std::uint64_t id_;
   const std::vector<Node<T>*>& targets_;
   bool all_leaves_;
-  std::vector<Node<T>*> order_;  // needed non-leaf nodes
-  std::vector<Node<T>*> leaves_;
-  std::vector<Var<T>> grads_;
+  std::vector<Node<T>*>& order_;  // needed non-leaf nodes
+  std::vector<Node<T>*>& leaves_;
+  std::vector<Var<T>>& grads_;
+  std::vector<std::pair<Node<T>*, std::size_t>>& stack_;
   int slots_ = 0;
   Node<T>* current_ = nullptr;
 };
@@ -136,11 +190,10 @@ std::string describe(const char* role, std::size_t index, const Var<T>& v) {
   return fmt::format("{} #{} ({} {})", role, index, v.shape(), v.op());
 }
 
-}  // namespace
-
 template <typename T>
-std::vector<Var<T>> grad(const std::vector<Var<T>>& outputs, const std::vector<Var<T>>& inputs,
-                         const GradOptions& options, const std::vector<Var<T>>& grad_outputs) {
+void grad_impl(std::span<const Var<T>> outputs, const std::vector<Var<T>>& inputs,
+               const GradOptions& options, std::span<const Var<T>> grad_outputs,
+               std::vector<Var<T>>& result) {
   HNN_AD_CHECK(!outputs.empty(), "grad: no outputs given");
   HNN_AD_CHECK(grad_outputs.empty() || grad_outputs.size() == outputs.size(),
                "grad: {} grad_outputs for {} outputs", grad_outputs.size(), outputs.size());
@@ -150,19 +203,19 @@ std::vector<Var<T>> grad(const std::vector<Var<T>>& outputs, const std::vector<V
                  "under a NoGradGuard",
                  describe("output", k, outputs[k]));
   }
-  std::vector<Node<T>*> targets;
+  BorrowedBuffers<T> buffers;
+  (*buffers).targets.clear();
   for (std::size_t j = 0; j < inputs.size(); ++j) {
     HNN_AD_CHECK(inputs[j].requires_grad(),
                  "grad: {} does not require gradients; create it with "
                  "Var::leaf(value, /*requires_grad=*/true)",
                  describe("input", j, inputs[j]));
-    targets.push_back(&inputs[j].node());
+    (*buffers).targets.push_back(&inputs[j].node());
   }
-  Sweep<T> sweep(targets, /*all_leaves=*/false);
+  Sweep<T> sweep(*buffers, /*all_leaves=*/false);
   sweep.run(outputs, grad_outputs, options.create_graph);
 
-  std::vector<Var<T>> result;
-  result.reserve(inputs.size());
+  result.resize(inputs.size());
   for (std::size_t j = 0; j < inputs.size(); ++j) {
     Var<T> g = sweep.result(inputs[j].node());
     if (!g.defined()) {
@@ -171,9 +224,24 @@ std::vector<Var<T>> grad(const std::vector<Var<T>>& outputs, const std::vector<V
                    describe("input", j, inputs[j]));
       g = Var<T>::constant(Matrix<T>::Zero(inputs[j].rows(), inputs[j].cols()));
     }
-    result.push_back(g);
+    result[j] = g;
   }
+}
+
+}  // namespace
+
+template <typename T>
+std::vector<Var<T>> grad(const std::vector<Var<T>>& outputs, const std::vector<Var<T>>& inputs,
+                         const GradOptions& options, const std::vector<Var<T>>& grad_outputs) {
+  std::vector<Var<T>> result;
+  grad_impl<T>(outputs, inputs, options, grad_outputs, result);
   return result;
+}
+
+template <typename T>
+void grad_into(const Var<T>& output, const std::vector<Var<T>>& inputs,
+               std::vector<Var<T>>& result, const GradOptions& options) {
+  grad_impl<T>(std::span<const Var<T>>(&output, 1), inputs, options, {}, result);
 }
 
 template <typename T>
@@ -183,11 +251,13 @@ void backward(const Var<T>& output, const Var<T>& grad_output) {
   HNN_AD_CHECK(output.requires_grad(),
                "backward: the output does not require gradients: it was computed from constants "
                "only or under a NoGradGuard");
-  const std::vector<Node<T>*> none;
-  Sweep<T> sweep(none, /*all_leaves=*/true);
-  std::vector<Var<T>> seeds;
-  if (grad_output.defined()) seeds.push_back(grad_output);
-  sweep.run({output}, seeds, /*create_graph=*/false);
+  BorrowedBuffers<T> buffers;
+  (*buffers).targets.clear();
+  Sweep<T> sweep(*buffers, /*all_leaves=*/true);
+  sweep.run(std::span<const Var<T>>(&output, 1),
+            grad_output.defined() ? std::span<const Var<T>>(&grad_output, 1)
+                                  : std::span<const Var<T>>(),
+            /*create_graph=*/false);
   for (Node<T>* leaf : sweep.leaves()) {
     const Var<T> g = sweep.result(*leaf);
     if (!g.defined()) continue;
@@ -203,6 +273,10 @@ template std::vector<Var<float>> grad(const std::vector<Var<float>>&,
 template std::vector<Var<double>> grad(const std::vector<Var<double>>&,
                                        const std::vector<Var<double>>&, const GradOptions&,
                                        const std::vector<Var<double>>&);
+template void grad_into(const Var<float>&, const std::vector<Var<float>>&,
+                        std::vector<Var<float>>&, const GradOptions&);
+template void grad_into(const Var<double>&, const std::vector<Var<double>>&,
+                        std::vector<Var<double>>&, const GradOptions&);
 template void backward(const Var<float>&, const Var<float>&);
 template void backward(const Var<double>&, const Var<double>&);
 

@@ -115,13 +115,15 @@ void hidden_rows(const Layers<T>& l, std::vector<Matrix<T>>& h, RowBlock r) {
 // One part's scratch, owned by the thread that runs the op (workers write into it).
 template <typename T>
 struct PartSpace {
-  std::vector<Matrix<T>> dw, db, hbar;
-  Matrix<T> a, b;
+  // Per layer, so that every buffer keeps one shape from step to step (no reallocation):
+  // partial weight and bias gradients, hbar_k, and the gradient propagated to layer k.
+  std::vector<Matrix<T>> dw, db, hbar, grad;
   void size_for(int layers) {
     if (int(dw.size()) < layers) {
       dw.resize(std::size_t(layers));
       db.resize(std::size_t(layers));
       hbar.resize(std::size_t(layers));
+      grad.resize(std::size_t(layers));
     }
   }
 };
@@ -198,7 +200,7 @@ void tanh_mlp_backward(const Node<T>& n, const Var<T>& g, GradSink<T>& s) {
   parallel_for(parts, [&](int p) {
     const RowBlock r = row_block(rows, parts, p);
     PartSpace<T>& w = space[std::size_t(p)];
-    Matrix<T>*delta = &w.a, *next = &w.b;
+    Matrix<T>* delta = &w.grad[std::size_t(l.count)];
     *delta = g.value().middleRows(r.begin, r.size());
     for (int k = l.count; k >= 1; --k) {
       const auto prev = k == 1 ? l.x().middleRows(r.begin, r.size())
@@ -207,10 +209,11 @@ void tanh_mlp_backward(const Node<T>& n, const Var<T>& g, GradSink<T>& s) {
       detail::gemm(prev, true, *delta, false, w.dw[std::size_t(k)]);
       if (l.bias_input(k) >= 0) w.db[std::size_t(k)] = delta->colwise().sum();
       if (k > 1) {
+        Matrix<T>* next = &w.grad[std::size_t(k - 1)];
         next->resize(delta->rows(), l.w(k).rows());
         detail::gemm(*delta, false, l.w(k), true, *next);
         next->array() *= T(1) - prev.array().square();
-        std::swap(delta, next);
+        delta = next;
       } else if (dx) {
         detail::gemm(*delta, false, l.w(1), true, dx->middleRows(r.begin, r.size()));
       }
@@ -286,20 +289,22 @@ void input_gradient_backward(const Node<T>& n, const Var<T>& g, GradSink<T>& s) 
     const RowBlock r = row_block(rows, parts, p);
     const auto block = [&](std::size_t i) { return n.buffers[i].middleRows(r.begin, r.size()); };
     PartSpace<T>& w = space[std::size_t(p)];
-    Matrix<T>*abar = &w.a, *dbar = &w.b;
+    Matrix<T>* abar = &w.grad[0];
     *abar = g.value().middleRows(r.begin, r.size());
-    for (int k = 1; k < L; ++k) {  // up the gradient chain
+    for (int k = 1; k < L; ++k) {  // up the gradient chain; dbar_k becomes abar_k in place
       const auto hk = block(at.h(k));
+      Matrix<T>* dbar = &w.grad[std::size_t(k)];
       dbar->resize(abar->rows(), l.w(k).cols());
       detail::gemm(*abar, false, l.w(k), false, *dbar);
       w.dw[std::size_t(k)].resize(abar->cols(), l.w(k).cols());
       detail::gemm(*abar, true, block(at.d(k)), false, w.dw[std::size_t(k)]);
-      w.hbar[std::size_t(k)] =
-          (T(-2) * hk.array() * block(at.a(k)).array() * dbar->array()).matrix();
+      w.hbar[std::size_t(k)].resize(dbar->rows(), dbar->cols());
+      w.hbar[std::size_t(k)].array() = T(-2) * hk.array() * block(at.a(k)).array() * dbar->array();
       dbar->array() *= T(1) - hk.array().square();
-      std::swap(abar, dbar);
+      abar = dbar;
     }
-    w.dw[std::size_t(L)] = abar->colwise().sum().transpose();
+    w.dw[std::size_t(L)].resize(abar->cols(), 1);
+    w.dw[std::size_t(L)].col(0) = abar->colwise().sum().transpose();
     Matrix<T>* hb = &w.hbar[std::size_t(L - 1)];
     for (int k = L - 1; k >= 1; --k) {  // down the forward chain; zbar_k in place of hbar_k
       hb->array() *= T(1) - block(at.h(k)).array().square();

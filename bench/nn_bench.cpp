@@ -49,10 +49,12 @@ void training_step(benchmark::State& state, nn::ModelKind kind) {
   const ad::Var<T> x = ad::Var<T>::leaf(data.x.cast<T>());
   const ad::Var<T> target = ad::Var<T>::leaf(data.dxdt.cast<T>(), /*requires_grad=*/false);
   double loss = 0;
+  std::vector<ad::Var<T>> grads;
   for (auto _ : state) {
     ad::TapeScope scope;  // the step's graph is recycled at the end of each iteration
     const ad::Var<T> l = nn::mse(model->time_derivative(x), target);
-    adam.step(ad::grad<T>({l}, adam.parameters()));
+    ad::grad_into(l, adam.parameters(), grads);
+    adam.step(grads);
     loss = double(l.item());
   }
   benchmark::DoNotOptimize(loss);

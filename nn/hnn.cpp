@@ -73,7 +73,10 @@ typename Hnn<T>::Parts Hnn<T>::time_derivative_parts(const ad::Var<T>& x) const 
       parts.conservative = dh;
     } else {
       const Index n = this->config_.dim / 2;
-      parts.solenoidal = ad::concat_cols<T>({ad::slice_cols(dh, n, n), -ad::slice_cols(dh, 0, n)});
+      thread_local std::vector<ad::Var<T>> halves;  // reused: no allocation per step
+      halves.assign({ad::slice_cols(dh, n, n), -ad::slice_cols(dh, 0, n)});
+      parts.solenoidal = ad::concat_cols<T>(halves);
+      halves.clear();
     }
     return parts;
   }

@@ -202,6 +202,7 @@ TrainResult train_model(nn::DynamicsModel<T>& model, const Dataset& data,
                .count();
   };
   const ArmStop arm(hooks.stop);
+  std::vector<ad::Var<T>> grads;  // reused: a step allocates nothing in steady state
   for (long step = first; step <= config.steps; ++step) {
     ad::TapeScope scope;  // everything this step records is recycled at the closing brace
     batches.next();
@@ -213,7 +214,8 @@ TrainResult train_model(nn::DynamicsModel<T>& model, const Dataset& data,
                                          loss_value, checkpoints.where()),
                              step);
     }
-    adam.step(ad::grad<T>({loss}, params));
+    ad::grad_into(loss, params, grads);
+    adam.step(grads);
     if (step % interval == 0 || step == config.steps) {
       const auto record_start = std::chrono::steady_clock::now();
       const double train = batches.full() ? loss_value

@@ -4,6 +4,7 @@
 
 #include <cstdlib>
 
+#include "malloc_counter.h"
 #include "nn_test_util.h"
 
 namespace ad = hnn::ad;
@@ -12,40 +13,16 @@ using ad::Var;
 using MatrixD = nn::Matrix<double>;
 
 // ---- counting heap allocations --------------------------------------------------------------
-// Every allocation (operator new and Eigen's buffers alike) goes through malloc, so the test
-// program interposes glibc's malloc to count calls while g_count_allocations is set. Skipped
-// under sanitizers, which provide their own malloc.
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
-#define HNN_COUNT_MALLOC 0
-#elif defined(__GLIBC__)
-#define HNN_COUNT_MALLOC 1
-#else
-#define HNN_COUNT_MALLOC 0
-#endif
-
-namespace {
-bool g_count_allocations = false;
-long g_allocations = 0;
-}  // namespace
-
-#if HNN_COUNT_MALLOC
-extern "C" void* __libc_malloc(std::size_t size);
-extern "C" void* malloc(std::size_t size) {
-  if (g_count_allocations) ++g_allocations;
-  return __libc_malloc(size);
-}
-#endif
+// malloc is interposed by allocation_test.cpp (not under the sanitizers: see malloc_counter.h).
 
 namespace {
 
 // The number of heap allocations made by f().
 template <typename F>
 long allocations_in(F f) {
-  g_allocations = 0;
-  g_count_allocations = true;
+  const long before = hnn::testing::allocation_count();
   f();
-  g_count_allocations = false;
-  return g_allocations;
+  return hnn::testing::allocation_count() - before;
 }
 
 Var<double> row(std::initializer_list<double> values) {
@@ -181,7 +158,7 @@ TEST(Optimizer, StepsFromGradientsAccumulatedByBackward) {
 }
 
 TEST(Optimizer, StepAllocatesNothing) {
-#if !HNN_COUNT_MALLOC
+#if !HNN_COUNTS_ALLOCATIONS
   GTEST_SKIP() << "allocation counting needs glibc without sanitizers";
 #endif
   std::mt19937_64 rng(1);

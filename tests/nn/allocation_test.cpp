@@ -1,0 +1,124 @@
+// A training step allocates nothing on the heap once warmed up: the tape recycles its nodes and
+// their buffers, the sweep and the fused kernels keep their scratch, GEMM packing stays in
+// OpenBLAS's pool. Counted by interposing malloc and friends in this test program (not under
+// the sanitizers, which own malloc); optim_test uses the same counter.
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cstdlib>
+#include <random>
+
+#include "autodiff/autodiff.h"
+#include "nn/nn.h"
+
+#include "malloc_counter.h"
+
+namespace {
+std::atomic<long> g_allocations{0};
+}  // namespace
+
+long hnn::testing::allocation_count() { return g_allocations.load(); }
+
+#if HNN_COUNTS_ALLOCATIONS
+#define HNN_COUNT_ALLOCATIONS 1
+
+extern "C" {
+void* __libc_malloc(std::size_t);
+void* __libc_calloc(std::size_t, std::size_t);
+void* __libc_realloc(void*, std::size_t);
+void* __libc_memalign(std::size_t, std::size_t);
+
+void* malloc(std::size_t n) {
+  g_allocations.fetch_add(1, std::memory_order_relaxed);
+  return __libc_malloc(n);
+}
+void* calloc(std::size_t n, std::size_t size) {
+  g_allocations.fetch_add(1, std::memory_order_relaxed);
+  return __libc_calloc(n, size);
+}
+void* realloc(void* p, std::size_t n) {
+  g_allocations.fetch_add(1, std::memory_order_relaxed);
+  return __libc_realloc(p, n);
+}
+void* aligned_alloc(std::size_t alignment, std::size_t n) {
+  g_allocations.fetch_add(1, std::memory_order_relaxed);
+  return __libc_memalign(alignment, n);
+}
+void* memalign(std::size_t alignment, std::size_t n) {
+  g_allocations.fetch_add(1, std::memory_order_relaxed);
+  return __libc_memalign(alignment, n);
+}
+int posix_memalign(void** out, std::size_t alignment, std::size_t n) {
+  g_allocations.fetch_add(1, std::memory_order_relaxed);
+  *out = __libc_memalign(alignment, n);
+  return *out ? 0 : 12;  // ENOMEM
+}
+}
+#endif
+
+namespace ad = hnn::ad;
+namespace nn = hnn::nn;
+
+namespace {
+
+// Heap allocations made by `steps` training steps of `kind` after `warmup` steps.
+template <typename T>
+long allocations_per_steps(nn::ModelKind kind, int threads, long rows, int warmup, int steps) {
+  ad::set_num_threads(threads);
+  std::mt19937_64 rng(3);
+  nn::DynamicsConfig config;
+  config.model = kind;
+  config.dim = 2;
+  config.hidden = {64, 64};
+  const auto model = nn::make_model<T>(config, rng);
+  nn::Adam<T> adam(model->parameters(), {.lr = 1e-3, .weight_decay = 1e-4});
+  const ad::Var<T> x = ad::Var<T>::leaf(nn::random_normal<T>(rows, 2, rng, 0, 1), false);
+  const ad::Var<T> target = ad::Var<T>::leaf(nn::random_normal<T>(rows, 2, rng, 0, 1), false);
+  std::vector<ad::Var<T>> grads;
+  long counted = 0;
+  for (int step = 0; step < warmup + steps; ++step) {
+#ifdef HNN_COUNT_ALLOCATIONS
+    const long before = g_allocations.load();
+#endif
+    {
+      ad::TapeScope scope;
+      const ad::Var<T> loss = nn::mse(model->time_derivative(x), target);
+      ad::grad_into(loss, adam.parameters(), grads);
+      adam.step(grads);
+    }
+#ifdef HNN_COUNT_ALLOCATIONS
+    if (step >= warmup) counted += g_allocations.load() - before;
+#endif
+  }
+  ad::set_num_threads(2);
+  return counted;
+}
+
+}  // namespace
+
+TEST(Allocations, TrainingStepsAllocateNothingAfterWarmUp) {
+#ifndef HNN_COUNT_ALLOCATIONS
+  GTEST_SKIP() << "malloc belongs to the sanitizer in this build";
+#endif
+  for (int threads : {1, 2}) {
+    EXPECT_EQ((allocations_per_steps<double>(nn::ModelKind::kHnn, threads, 300, 3, 20)), 0)
+        << "HNN, double, " << threads << " thread(s)";
+    EXPECT_EQ((allocations_per_steps<float>(nn::ModelKind::kHnn, threads, 300, 3, 20)), 0)
+        << "HNN, float, " << threads << " thread(s)";
+    EXPECT_EQ((allocations_per_steps<double>(nn::ModelKind::kBaseline, threads, 300, 3, 20)), 0)
+        << "baseline, double, " << threads << " thread(s)";
+  }
+}
+
+TEST(Allocations, TheCounterSeesAllocations) {
+#ifndef HNN_COUNT_ALLOCATIONS
+  GTEST_SKIP() << "malloc belongs to the sanitizer in this build";
+#else
+  const long before = g_allocations.load();
+  std::vector<double>* v = new std::vector<double>(1000);
+  const long after = g_allocations.load();
+  delete v;
+  EXPECT_GE(after - before, 2);  // the vector object and its buffer
+#endif
+}

@@ -1,0 +1,14 @@
+#pragma once
+// Heap allocations counted by interposing glibc's malloc family in the nn test program
+// (defined in allocation_test.cpp). Not under the sanitizers, which own malloc.
+
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__) || !defined(__GLIBC__)
+#define HNN_COUNTS_ALLOCATIONS 0
+#else
+#define HNN_COUNTS_ALLOCATIONS 1
+#endif
+
+namespace hnn::testing {
+/// Allocations by every thread since the program started (0 when not counting).
+long allocation_count();
+}  // namespace hnn::testing
