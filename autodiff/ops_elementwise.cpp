@@ -31,6 +31,13 @@ void apply_broadcast(const Matrix<T>& a, const Matrix<T>& b, Matrix<T>& out, Eig
   out.resize(rows, cols);
   if (a.rows() == rows && a.cols() == cols && b.rows() == rows && b.cols() == cols) {
     out.array() = f(a.array(), b.array());
+  } else if (a.rows() == rows && a.cols() == cols && b.rows() == 1 && b.cols() == cols) {
+    // a row broadcast (a bias, a scale): row by row, vectorised (replicate is not)
+    for (Eigen::Index i = 0; i < rows; ++i)
+      out.row(i).array() = f(a.row(i).array(), b.row(0).array());
+  } else if (b.rows() == rows && b.cols() == cols && a.rows() == 1 && a.cols() == cols) {
+    for (Eigen::Index i = 0; i < rows; ++i)
+      out.row(i).array() = f(a.row(0).array(), b.row(i).array());
   } else {
     out.array() = f(a.replicate(rows / a.rows(), cols / a.cols()).array(),
                     b.replicate(rows / b.rows(), cols / b.cols()).array());
@@ -152,9 +159,7 @@ template <typename T>
 Var<T> square(const Var<T>& x) {
   return unary<T>(
       "square", x,
-      [](const Node<T>& n, const Var<T>& g, GradSink<T>& s) {
-        s.add(0, scale(g * in0(n), T(2)));
-      },
+      [](const Node<T>& n, const Var<T>& g, GradSink<T>& s) { s.add(0, scale(g * in0(n), T(2))); },
       [](auto v) { return v.square(); });
 }
 
@@ -212,8 +217,8 @@ Var<T> cos(const Var<T>& x) {
 
 template <typename T>
 Var<T> tanh(const Var<T>& x) {
-  Node<T>& node = detail::record<T>(
-      "tanh", {x}, [](const Node<T>& n, const Var<T>& g, GradSink<T>& s) {
+  Node<T>& node =
+      detail::record<T>("tanh", {x}, [](const Node<T>& n, const Var<T>& g, GradSink<T>& s) {
         s.add(0, tanh_backward(g, Var<T>::of(n)));
       });
   tanh_into(x.value(), node.value);
@@ -313,29 +318,29 @@ Var<T> swish(const Var<T>& x) {
   return x * sigmoid(x);
 }
 
-#define HNN_INSTANTIATE(T)                                                         \
-  template Var<T> add(const Var<T>&, const Var<T>&);                               \
-  template Var<T> sub(const Var<T>&, const Var<T>&);                               \
-  template Var<T> mul(const Var<T>&, const Var<T>&);                               \
-  template Var<T> div(const Var<T>&, const Var<T>&);                               \
-  template Var<T> neg(const Var<T>&);                                              \
-  template Var<T> scale(const Var<T>&, T);                                         \
-  template Var<T> shift(const Var<T>&, T);                                         \
-  template Var<T> square(const Var<T>&);                                           \
-  template Var<T> pow(const Var<T>&, T);                                           \
-  template Var<T> sqrt(const Var<T>&);                                             \
-  template Var<T> exp(const Var<T>&);                                              \
-  template Var<T> log(const Var<T>&);                                              \
-  template Var<T> sin(const Var<T>&);                                              \
-  template Var<T> cos(const Var<T>&);                                              \
-  template Var<T> tanh(const Var<T>&);                                             \
-  template Var<T> tanh_backward(const Var<T>&, const Var<T>&);                     \
-  template Var<T> sigmoid(const Var<T>&);                                          \
-  template Var<T> step(const Var<T>&);                                             \
-  template Var<T> relu(const Var<T>&);                                             \
-  template Var<T> softplus(const Var<T>&);                                         \
-  template Var<T> elu(const Var<T>&, T);                                           \
-  template Var<T> selu(const Var<T>&);                                             \
+#define HNN_INSTANTIATE(T)                                     \
+  template Var<T> add(const Var<T>&, const Var<T>&);           \
+  template Var<T> sub(const Var<T>&, const Var<T>&);           \
+  template Var<T> mul(const Var<T>&, const Var<T>&);           \
+  template Var<T> div(const Var<T>&, const Var<T>&);           \
+  template Var<T> neg(const Var<T>&);                          \
+  template Var<T> scale(const Var<T>&, T);                     \
+  template Var<T> shift(const Var<T>&, T);                     \
+  template Var<T> square(const Var<T>&);                       \
+  template Var<T> pow(const Var<T>&, T);                       \
+  template Var<T> sqrt(const Var<T>&);                         \
+  template Var<T> exp(const Var<T>&);                          \
+  template Var<T> log(const Var<T>&);                          \
+  template Var<T> sin(const Var<T>&);                          \
+  template Var<T> cos(const Var<T>&);                          \
+  template Var<T> tanh(const Var<T>&);                         \
+  template Var<T> tanh_backward(const Var<T>&, const Var<T>&); \
+  template Var<T> sigmoid(const Var<T>&);                      \
+  template Var<T> step(const Var<T>&);                         \
+  template Var<T> relu(const Var<T>&);                         \
+  template Var<T> softplus(const Var<T>&);                     \
+  template Var<T> elu(const Var<T>&, T);                       \
+  template Var<T> selu(const Var<T>&);                         \
   template Var<T> swish(const Var<T>&);
 HNN_INSTANTIATE(float)
 HNN_INSTANTIATE(double)

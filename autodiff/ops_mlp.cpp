@@ -16,6 +16,7 @@
 #include "autodiff/op_builder.h"
 #include "autodiff/ops.h"
 #include "autodiff/parallel.h"
+#include "autodiff/row_kernels.h"
 
 namespace hnn::ad {
 
@@ -207,7 +208,10 @@ void tanh_mlp_backward(const Node<T>& n, const Var<T>& g, GradSink<T>& s) {
                                : n.buffers[std::size_t(k - 2)].middleRows(r.begin, r.size());
       w.dw[std::size_t(k)].resize(prev.cols(), delta->cols());
       detail::gemm(prev, true, *delta, false, w.dw[std::size_t(k)]);
-      if (l.bias_input(k) >= 0) w.db[std::size_t(k)] = delta->colwise().sum();
+      if (l.bias_input(k) >= 0) {
+        w.db[std::size_t(k)].resize(1, delta->cols());
+        detail::column_sums(*delta, w.db[std::size_t(k)]);
+      }
       if (k > 1) {
         Matrix<T>* next = &w.grad[std::size_t(k - 1)];
         next->resize(delta->rows(), l.w(k).rows());
@@ -304,13 +308,16 @@ void input_gradient_backward(const Node<T>& n, const Var<T>& g, GradSink<T>& s) 
       abar = dbar;
     }
     w.dw[std::size_t(L)].resize(abar->cols(), 1);
-    w.dw[std::size_t(L)].col(0) = abar->colwise().sum().transpose();
+    detail::column_sums(*abar, w.dw[std::size_t(L)].col(0).transpose());
     Matrix<T>* hb = &w.hbar[std::size_t(L - 1)];
     for (int k = L - 1; k >= 1; --k) {  // down the forward chain; zbar_k in place of hbar_k
       hb->array() *= T(1) - block(at.h(k)).array().square();
       const auto prev = k == 1 ? l.x().middleRows(r.begin, r.size()) : block(at.h(k - 1));
       detail::gemm(prev, true, *hb, false, w.dw[std::size_t(k)], T(1));
-      if (l.bias_input(k) >= 0) w.db[std::size_t(k)] = hb->colwise().sum();
+      if (l.bias_input(k) >= 0) {
+        w.db[std::size_t(k)].resize(1, hb->cols());
+        detail::column_sums(*hb, w.db[std::size_t(k)]);
+      }
       if (k > 1) {
         detail::gemm(*hb, false, l.w(k), true, w.hbar[std::size_t(k - 1)], T(1));
         hb = &w.hbar[std::size_t(k - 1)];
@@ -384,12 +391,12 @@ Var<T> tanh_mlp_input_gradient(const Var<T>& x, const std::vector<Var<T>>& weigh
     const auto block = [&](std::size_t i) { return node.buffers[i].middleRows(r.begin, r.size()); };
     hidden_rows(l, node.buffers, r);
     auto out = node.value.middleRows(r.begin, r.size());
-    const auto top = l.w(L).transpose().replicate(r.size(), 1);
+    const auto top = l.w(L).col(0).transpose();  // dy/dh_{L-1}, the same for every row
     if (L == 1) {
-      out = top;
+      detail::fill_rows(out, top);
       return;
     }
-    block(at.a(L - 1)) = top;
+    detail::fill_rows(block(at.a(L - 1)), top);
     for (int k = L - 1; k >= 1; --k) {
       block(at.d(k)).array() = block(at.a(k)).array() * (T(1) - block(at.h(k)).array().square());
       if (k > 1) {

@@ -2,6 +2,7 @@
 
 #include "autodiff/op_builder.h"
 #include "autodiff/ops.h"
+#include "autodiff/row_kernels.h"
 
 namespace hnn::ad {
 
@@ -38,7 +39,8 @@ void sum_all(const Matrix<T>& x, Matrix<T>& out) {
 }
 template <typename T>
 void sum_over_rows(const Matrix<T>& x, Matrix<T>& out) {
-  out.noalias() = x.colwise().sum();
+  out.resize(1, x.cols());
+  detail::column_sums(x, out);
 }
 template <typename T>
 void sum_over_cols(const Matrix<T>& x, Matrix<T>& out) {
@@ -80,11 +82,16 @@ Var<T> broadcast_to(const Var<T>& a, Eigen::Index rows, Eigen::Index cols) {
   HNN_AD_CHECK((a.rows() == rows || a.rows() == 1) && (a.cols() == cols || a.cols() == 1),
                "broadcast_to: cannot broadcast {} to {}", a.shape(), shape_str(rows, cols));
   if (a.rows() == rows && a.cols() == cols) return a;
-  Node<T>& node = detail::record<T>(
-      "broadcast_to", {a}, [](const Node<T>& n, const Var<T>& g, GradSink<T>& s) {
+  Node<T>& node =
+      detail::record<T>("broadcast_to", {a}, [](const Node<T>& n, const Var<T>& g, GradSink<T>& s) {
         s.add(0, sum_to(g, in0(n).rows(), in0(n).cols()));
       });
-  node.value = a.value().replicate(rows / a.rows(), cols / a.cols());
+  if (a.rows() == 1 && a.cols() == cols) {  // the common case: a row to every row
+    node.value.resize(rows, cols);
+    detail::fill_rows(node.value, a.value().row(0));
+  } else {
+    node.value = a.value().replicate(rows / a.rows(), cols / a.cols());
+  }
   return Var<T>::of(node);
 }
 
@@ -102,8 +109,8 @@ template <typename T>
 Var<T> slice_cols(const Var<T>& a, Eigen::Index start, Eigen::Index count) {
   HNN_AD_CHECK(start >= 0 && count >= 0 && start + count <= a.cols(),
                "slice_cols: columns [{}, {}) out of range for {}", start, start + count, a.shape());
-  Node<T>& node = detail::record<T>(
-      "slice_cols", {a}, [](const Node<T>& n, const Var<T>& g, GradSink<T>& s) {
+  Node<T>& node =
+      detail::record<T>("slice_cols", {a}, [](const Node<T>& n, const Var<T>& g, GradSink<T>& s) {
         s.add(0, pad_cols(g, static_cast<Eigen::Index>(n.saved[0]), in0(n).cols()));
       });
   node.saved[0] = double(start);
@@ -115,8 +122,8 @@ template <typename T>
 Var<T> pad_cols(const Var<T>& a, Eigen::Index start, Eigen::Index cols) {
   HNN_AD_CHECK(start >= 0 && start + a.cols() <= cols,
                "pad_cols: {} does not fit at column {} of {} columns", a.shape(), start, cols);
-  Node<T>& node = detail::record<T>(
-      "pad_cols", {a}, [](const Node<T>& n, const Var<T>& g, GradSink<T>& s) {
+  Node<T>& node =
+      detail::record<T>("pad_cols", {a}, [](const Node<T>& n, const Var<T>& g, GradSink<T>& s) {
         s.add(0, slice_cols(g, static_cast<Eigen::Index>(n.saved[0]), in0(n).cols()));
       });
   node.saved[0] = double(start);
@@ -134,16 +141,15 @@ Var<T> concat_cols(const std::vector<Var<T>>& parts) {
                  parts[0].shape(), p.shape());
     cols += p.cols();
   }
-  Node<T>& node = detail::record<T>(
-      "concat_cols", std::span<const Var<T>>(parts),
-      [](const Node<T>& n, const Var<T>& g, GradSink<T>& s) {
-        Eigen::Index start = 0;
-        for (int i = 0; i < int(n.inputs.size()); ++i) {
-          const Eigen::Index width = n.inputs[i].cols();
-          if (s.wants(i)) s.add(i, slice_cols(g, start, width));
-          start += width;
-        }
-      });
+  Node<T>& node = detail::record<T>("concat_cols", std::span<const Var<T>>(parts),
+                                    [](const Node<T>& n, const Var<T>& g, GradSink<T>& s) {
+                                      Eigen::Index start = 0;
+                                      for (int i = 0; i < int(n.inputs.size()); ++i) {
+                                        const Eigen::Index width = n.inputs[i].cols();
+                                        if (s.wants(i)) s.add(i, slice_cols(g, start, width));
+                                        start += width;
+                                      }
+                                    });
   node.value.resize(parts[0].rows(), cols);
   Eigen::Index start = 0;
   for (const Var<T>& p : parts) {
@@ -153,17 +159,17 @@ Var<T> concat_cols(const std::vector<Var<T>>& parts) {
   return Var<T>::of(node);
 }
 
-#define HNN_INSTANTIATE(T)                                                  \
-  template Var<T> sum(const Var<T>&);                                       \
-  template Var<T> mean(const Var<T>&);                                      \
-  template Var<T> sum_rows(const Var<T>&);                                  \
-  template Var<T> sum_cols(const Var<T>&);                                  \
-  template Var<T> mean_rows(const Var<T>&);                                 \
-  template Var<T> mean_cols(const Var<T>&);                                 \
-  template Var<T> broadcast_to(const Var<T>&, Eigen::Index, Eigen::Index);  \
-  template Var<T> sum_to(const Var<T>&, Eigen::Index, Eigen::Index);        \
-  template Var<T> slice_cols(const Var<T>&, Eigen::Index, Eigen::Index);    \
-  template Var<T> pad_cols(const Var<T>&, Eigen::Index, Eigen::Index);      \
+#define HNN_INSTANTIATE(T)                                                 \
+  template Var<T> sum(const Var<T>&);                                      \
+  template Var<T> mean(const Var<T>&);                                     \
+  template Var<T> sum_rows(const Var<T>&);                                 \
+  template Var<T> sum_cols(const Var<T>&);                                 \
+  template Var<T> mean_rows(const Var<T>&);                                \
+  template Var<T> mean_cols(const Var<T>&);                                \
+  template Var<T> broadcast_to(const Var<T>&, Eigen::Index, Eigen::Index); \
+  template Var<T> sum_to(const Var<T>&, Eigen::Index, Eigen::Index);       \
+  template Var<T> slice_cols(const Var<T>&, Eigen::Index, Eigen::Index);   \
+  template Var<T> pad_cols(const Var<T>&, Eigen::Index, Eigen::Index);     \
   template Var<T> concat_cols(const std::vector<Var<T>>&);
 HNN_INSTANTIATE(float)
 HNN_INSTANTIATE(double)

@@ -1,0 +1,234 @@
+// How close a training step is to what the hardware allows. For each task's step shape (the
+// paper's tanh MLP, input -> 200 -> 200 -> out, at the task's batch) it reports:
+//   flops       the step's floating-point operations, counted from the shapes (GEMMs and the
+//               elementwise work of the fused kernels; Adam's few per parameter);
+//   GFLOP/s     flops / step time;
+//   gemm_GF/s   the rate of the engine's own GEMM (ad::matmul, same backend and thread split)
+//               at the step's largest shapes, measured here, before the step;
+//   of_gemm     the step's GEMM time at that rate / step time: 1 means the step is nothing but
+//               GEMMs running at their standalone speed;
+//   of_peak     flops / (raw FMA peak x step time), the peak measured by a register-only FMA
+//               loop on as many threads (BM_FmaPeak reports it on its own).
+// Wall time; run with --benchmark_repetitions=5 --benchmark_report_aggregates_only=true.
+
+#include <benchmark/benchmark.h>
+#include <immintrin.h>
+
+#include <algorithm>
+#include <chrono>
+#include <random>
+#include <thread>
+#include <vector>
+
+#include "autodiff/autodiff.h"
+#include "nn/nn.h"
+
+namespace ad = hnn::ad;
+namespace nn = hnn::nn;
+
+namespace {
+
+// ---- raw FMA peak --------------------------------------------------------------------------
+
+// FMAs on independent accumulators in registers (enough of them to cover the FMA latency on
+// two pipes); returns the FLOPs done.
+template <typename T>
+double fma_loop(long iterations) {
+#if defined(__AVX512F__)
+  constexpr int lanes = 64 / sizeof(T);
+  const auto fma = [](auto a, auto b, auto c) {
+    if constexpr (std::is_same_v<T, float>)
+      return _mm512_fmadd_ps(a, b, c);
+    else
+      return _mm512_fmadd_pd(a, b, c);
+  };
+  const auto set = [](T v) {
+    if constexpr (std::is_same_v<T, float>)
+      return _mm512_set1_ps(v);
+    else
+      return _mm512_set1_pd(v);
+  };
+  using V = decltype(set(T(0)));
+#elif defined(__AVX2__) && defined(__FMA__)
+  constexpr int lanes = 32 / sizeof(T);
+  const auto fma = [](auto a, auto b, auto c) {
+    if constexpr (std::is_same_v<T, float>)
+      return _mm256_fmadd_ps(a, b, c);
+    else
+      return _mm256_fmadd_pd(a, b, c);
+  };
+  const auto set = [](T v) {
+    if constexpr (std::is_same_v<T, float>)
+      return _mm256_set1_ps(v);
+    else
+      return _mm256_set1_pd(v);
+  };
+  using V = decltype(set(T(0)));
+#else
+#error "roofline_bench needs AVX2+FMA or AVX-512 (build with -march=native)"
+#endif
+  constexpr int kAcc = 12;
+  V acc[kAcc];
+  for (int i = 0; i < kAcc; ++i) acc[i] = set(T(i));
+  const V a = set(T(0.999999)), b = set(T(1e-7));
+  for (long it = 0; it < iterations; ++it) {
+    for (int i = 0; i < kAcc; ++i) acc[i] = fma(acc[i], a, b);  // not foldable: kept
+  }
+  benchmark::DoNotOptimize(acc);
+  return 2.0 * lanes * kAcc * double(iterations);
+}
+
+// Peak FLOP/s of `threads` threads running the FMA loop at once (best of a few tries).
+template <typename T>
+double fma_peak(int threads) {
+  constexpr long kIterations = 20'000'000;
+  double best = 0;
+  for (int attempt = 0; attempt < 5; ++attempt) {
+    const auto start = std::chrono::steady_clock::now();
+    std::vector<double> done(std::size_t(threads), 0.0);
+    std::vector<std::thread> pool;
+    for (int t = 0; t < threads; ++t) {
+      pool.emplace_back([&done, t] { done[std::size_t(t)] = fma_loop<T>(kIterations); });
+    }
+    for (std::thread& t : pool) t.join();
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    double flops = 0;
+    for (double f : done) flops += f;
+    best = std::max(best, flops / seconds);
+  }
+  return best;
+}
+
+// ---- the step's shapes and FLOPs -----------------------------------------------------------
+
+struct StepShape {
+  const char* task;
+  long rows;  // the batch
+  long dim;   // the state's dimension
+};
+constexpr StepShape kShapes[] = {{"spring", 750, 2}, {"two-body", 200, 8}, {"three-body", 600, 12}};
+constexpr long kWidth = 200;
+
+// FLOPs of one HNN step (fused forward, input gradient and their backward: see the derivation
+// at the top of autodiff/ops_mlp.cpp) or baseline step (forward and backward), with two hidden
+// layers of width n. GEMM m x n x k counts 2mnk.
+double step_flops(const StepShape& s, nn::ModelKind kind) {
+  const double R = double(s.rows), d = double(s.dim), n = kWidth;
+  const double params = d * n + n + n * n + n + n * (kind == nn::ModelKind::kHnn ? 1 : d);
+  double gemm = 0, elementwise = 0;
+  if (kind == nn::ModelKind::kHnn) {
+    // forward h1 = x W1, h2 = h1 W2; a1 = d2 W2^T, dH/dx = d1 W1^T;
+    // backward dbar1 = G W1, dW1 += G^T d1, dbar2 = abar1 W2, dW2 += abar1^T d2,
+    // dW2 += h1^T zbar2, hbar1 += zbar2 W2^T, dW1 += x^T zbar1.
+    gemm = 2 * R * (d * n + n * n) + 2 * R * (n * n + n * d) + 2 * R * (d * n + d * n) +
+           2 * R * (4 * n * n) + 2 * R * d * n;
+    elementwise = R * n * 2 * 20;  // tanh, s, d, hbar, abar, zbar, column sums: ~20 per entry
+  } else {
+    gemm = 2 * R * (d * n + n * n + n * d) * 3 - 2 * R * d * n;  // forward, dW, dH (no dx)
+    elementwise = R * n * 2 * 12;
+  }
+  return gemm + elementwise + 12 * params;  // Adam: about 12 per parameter
+}
+
+// Time of the step's big GEMMs (R x n x n, four or six of them) through ad::matmul.
+template <typename T>
+double gemm_seconds(const StepShape& s, nn::ModelKind kind, double& rate) {
+  std::mt19937_64 rng(5);
+  const auto a = ad::Var<T>::constant(nn::random_normal<T>(s.rows, kWidth, rng, 0, 1));
+  const auto w = ad::Var<T>::constant(nn::random_normal<T>(kWidth, kWidth, rng, 0, 1));
+  const int count = kind == nn::ModelKind::kHnn ? 6 : 3;
+  std::vector<double> times;
+  for (int rep = 0; rep < 40; ++rep) {
+    ad::TapeScope scope;
+    ad::NoGradGuard values;
+    const auto start = std::chrono::steady_clock::now();
+    for (int g = 0; g < count; ++g) {
+      // the kernels' three layouts: h W, d W^T, and h^T d
+      if (g % 3 == 0) benchmark::DoNotOptimize(ad::matmul(a, w).value().data());
+      if (g % 3 == 1) benchmark::DoNotOptimize(ad::matmul(a, w, false, true).value().data());
+      if (g % 3 == 2) benchmark::DoNotOptimize(ad::matmul(a, a, true, false).value().data());
+    }
+    times.push_back(
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  }
+  std::nth_element(times.begin(), times.begin() + 20, times.end());
+  rate = count * 2.0 * double(s.rows) * kWidth * kWidth / times[20];
+  return times[20];
+}
+
+template <typename T>
+void BM_StepRoofline(benchmark::State& state, nn::ModelKind kind) {
+  const StepShape& shape = kShapes[state.range(0)];
+  const int threads = int(state.range(1));
+  state.SetLabel(shape.task);
+  ad::set_num_threads(threads);
+  std::mt19937_64 rng(1);
+  nn::DynamicsConfig config;
+  config.model = kind;
+  config.dim = int(shape.dim);
+  const auto model = nn::make_model<T>(config, rng);
+  nn::Adam<T> adam(model->parameters(), {.lr = 1e-3, .weight_decay = 1e-4});
+  const ad::Var<T> x =
+      ad::Var<T>::leaf(nn::random_normal<T>(shape.rows, shape.dim, rng, 0, 1), false);
+  const ad::Var<T> target =
+      ad::Var<T>::leaf(nn::random_normal<T>(shape.rows, shape.dim, rng, 0, 1), false);
+  double gemm_rate = 0;
+  const double gemm_time = gemm_seconds<T>(shape, kind, gemm_rate);
+  std::vector<ad::Var<T>> grads;
+  for (auto _ : state) {
+    ad::TapeScope scope;
+    const ad::Var<T> loss = nn::mse(model->time_derivative(x), target);
+    ad::grad_into(loss, adam.parameters(), grads);
+    adam.step(grads);
+  }
+  const double flops = step_flops(shape, kind);
+  const double peak = fma_peak<T>(threads);
+  state.counters["flops"] = flops;
+  state.counters["GFLOP/s"] =
+      benchmark::Counter(flops * 1e-9, benchmark::Counter::kIsIterationInvariantRate);
+  state.counters["gemm_GF/s"] = gemm_rate * 1e-9;
+  state.counters["peak_GF/s"] = peak * 1e-9;
+  // Fractions need the step time: per-iteration seconds are only known after the loop.
+  state.counters["of_gemm"] =
+      benchmark::Counter(gemm_time, benchmark::Counter::kIsIterationInvariantRate);
+  state.counters["of_peak"] =
+      benchmark::Counter(flops / peak, benchmark::Counter::kIsIterationInvariantRate);
+  ad::set_num_threads(2);
+}
+
+template <typename T>
+void BM_HnnRoofline(benchmark::State& state) {
+  BM_StepRoofline<T>(state, nn::ModelKind::kHnn);
+}
+template <typename T>
+void BM_BaselineRoofline(benchmark::State& state) {
+  BM_StepRoofline<T>(state, nn::ModelKind::kBaseline);
+}
+
+template <typename T>
+void BM_FmaPeak(benchmark::State& state) {
+  const int threads = int(state.range(0));
+  double peak = 0;
+  for (auto _ : state) peak = fma_peak<T>(threads);
+  state.counters["peak_GF/s"] = peak * 1e-9;
+}
+
+void shapes_and_threads(benchmark::internal::Benchmark* b) {
+  b->ArgNames({"shape", "threads"});
+  for (long s = 0; s < long(std::size(kShapes)); ++s) {
+    for (long t : {1, 2}) b->Args({s, t});
+  }
+  b->Unit(benchmark::kMillisecond)->UseRealTime();
+}
+
+}  // namespace
+
+BENCHMARK(BM_FmaPeak<float>)->Arg(1)->Arg(2)->Iterations(1)->UseRealTime();
+BENCHMARK(BM_FmaPeak<double>)->Arg(1)->Arg(2)->Iterations(1)->UseRealTime();
+BENCHMARK(BM_HnnRoofline<float>)->Apply(shapes_and_threads);
+BENCHMARK(BM_HnnRoofline<double>)->Apply(shapes_and_threads);
+BENCHMARK(BM_BaselineRoofline<float>)->Apply(shapes_and_threads);
+BENCHMARK(BM_BaselineRoofline<double>)->Apply(shapes_and_threads);
+
+BENCHMARK_MAIN();
