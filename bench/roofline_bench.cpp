@@ -9,6 +9,8 @@
 //               GEMMs running at their standalone speed;
 //   of_peak     flops / (raw FMA peak x step time), the peak measured by a register-only FMA
 //               loop on as many threads (BM_FmaPeak reports it on its own).
+// The pixel-pendulum step (200 pairs of frames through the 1568-200-200-200-2 autoencoder and
+// back, with the latent HNN or baseline) is reported the same way (BM_PixelRoofline).
 // Wall time; run with --benchmark_repetitions=5 --benchmark_report_aggregates_only=true.
 
 #include <benchmark/benchmark.h>
@@ -22,9 +24,11 @@
 
 #include "autodiff/autodiff.h"
 #include "nn/nn.h"
+#include "tasks/pixel_pendulum.h"
 
 namespace ad = hnn::ad;
 namespace nn = hnn::nn;
+namespace pixel = hnn::tasks::pixel;
 
 namespace {
 
@@ -206,6 +210,86 @@ void BM_BaselineRoofline(benchmark::State& state) {
   BM_StepRoofline<T>(state, nn::ModelKind::kBaseline);
 }
 
+// ---- the pixel-pendulum step: the residual ReLU autoencoder with a latent model ------------
+
+constexpr long kPixelRows = 200, kPixels = pixel::kPairPixels, kLatent = 2;
+
+// GEMM FLOPs of one pixel step: two encodes (x and x_next) and one decode forward; backward
+// gives every weight gradient and every input gradient but the first encoder layer's (the
+// frames are constants). Plus the latent model's own step and Adam on the autoencoder.
+double pixel_step_flops(nn::ModelKind kind) {
+  const double R = kPixelRows, D = kPixels, n = kWidth, z = kLatent;
+  const double half = 2 * (D * n + 2 * n * n + n * z);  // one encode or decode, per row
+  const double forward = 3 * half;
+  const double backward = 2 * forward - 2 * (2 * D * n);
+  const double params = 2 * (D * n + n + 2 * (n * n + n) + n * z) + z + D;
+  const StepShape latent{"latent", kPixelRows, kLatent};
+  return R * (forward + backward) + step_flops(latent, kind) + 12 * params;
+}
+
+// The rate of ad::matmul at the autoencoder's big shapes (R x D x n in its three layouts).
+template <typename T>
+double pixel_gemm_rate() {
+  std::mt19937_64 rng(5);
+  const auto x = ad::Var<T>::constant(nn::random_normal<T>(kPixelRows, kPixels, rng, 0, 1));
+  const auto w = ad::Var<T>::constant(nn::random_normal<T>(kPixels, kWidth, rng, 0, 1));
+  const auto g = ad::Var<T>::constant(nn::random_normal<T>(kPixelRows, kWidth, rng, 0, 1));
+  std::vector<double> times;
+  for (int rep = 0; rep < 20; ++rep) {
+    ad::TapeScope scope;
+    ad::NoGradGuard values;
+    const auto start = std::chrono::steady_clock::now();
+    benchmark::DoNotOptimize(ad::matmul(x, w).value().data());               // x W
+    benchmark::DoNotOptimize(ad::matmul(g, w, false, true).value().data());  // g W^T
+    benchmark::DoNotOptimize(ad::matmul(x, g, true, false).value().data());  // x^T g
+    times.push_back(
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  }
+  std::nth_element(times.begin(), times.begin() + 10, times.end());
+  return 3 * 2.0 * kPixelRows * kPixels * kWidth / times[10];
+}
+
+// The trainer's step (tasks/pixel_pendulum.cpp) on random frames: loss, gradients, Adam.
+template <typename T>
+void BM_PixelRoofline(benchmark::State& state) {
+  const auto kind = state.range(0) == 0 ? nn::ModelKind::kHnn
+                                        : nn::ModelKind::kBaseline;  // model:0 HNN, 1 baseline
+  const int threads = int(state.range(1));
+  state.SetLabel(kind == nn::ModelKind::kHnn ? "pixel hnn" : "pixel baseline");
+  ad::set_num_threads(threads);
+  std::mt19937_64 rng(1);
+  pixel::PixelModel<T> model(pixel::PixelConfig{}, kind, rng);
+  const std::vector<ad::Var<T>> params = model.parameters();
+  nn::Adam<T> adam(params, {.lr = 1e-3, .weight_decay = 1e-5});
+  const auto frames = [&] {
+    ad::Matrix<T> m = nn::random_normal<T>(kPixelRows, kPixels, rng, 0, 1);
+    return ad::Var<T>::constant(m.cwiseAbs().cwiseMin(T(1)));
+  };
+  const ad::Var<T> x = frames(), x_next = frames();
+  const double gemm_rate = pixel_gemm_rate<T>();
+  std::vector<ad::Var<T>> grads;
+  for (auto _ : state) {
+    ad::TapeScope scope;
+    const ad::Var<T> loss = ad::mean(pixel::pixel_loss(model, x, x_next, 0.1).total);
+    ad::grad_into(loss, params, grads);
+    adam.step(grads);
+  }
+  const double flops = pixel_step_flops(kind);
+  const double peak = fma_peak<T>(threads);
+  state.counters["flops"] = flops;
+  state.counters["GFLOP/s"] =
+      benchmark::Counter(flops * 1e-9, benchmark::Counter::kIsIterationInvariantRate);
+  state.counters["gemm_GF/s"] = gemm_rate * 1e-9;
+  state.counters["peak_GF/s"] = peak * 1e-9;
+  // Almost all of this step is GEMMs of those shapes: of_gemm is the whole step's FLOPs at
+  // that rate over the step time.
+  state.counters["of_gemm"] =
+      benchmark::Counter(flops / gemm_rate, benchmark::Counter::kIsIterationInvariantRate);
+  state.counters["of_peak"] =
+      benchmark::Counter(flops / peak, benchmark::Counter::kIsIterationInvariantRate);
+  ad::set_num_threads(2);
+}
+
 template <typename T>
 void BM_FmaPeak(benchmark::State& state) {
   const int threads = int(state.range(0));
@@ -230,5 +314,16 @@ BENCHMARK(BM_HnnRoofline<float>)->Apply(shapes_and_threads);
 BENCHMARK(BM_HnnRoofline<double>)->Apply(shapes_and_threads);
 BENCHMARK(BM_BaselineRoofline<float>)->Apply(shapes_and_threads);
 BENCHMARK(BM_BaselineRoofline<double>)->Apply(shapes_and_threads);
+
+BENCHMARK(BM_PixelRoofline<float>)
+    ->ArgNames({"model", "threads"})
+    ->ArgsProduct({{0, 1}, {1, 2}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK(BM_PixelRoofline<double>)
+    ->ArgNames({"model", "threads"})
+    ->ArgsProduct({{0, 1}, {1, 2}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 BENCHMARK_MAIN();
