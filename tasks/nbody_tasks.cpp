@@ -12,6 +12,9 @@ struct NBodySettings {
   int bodies, trajectories, points;
   double t_end;
   TrainConfig train;
+  // The `lean` preset (docs/speed_accuracy.md, chart 4): lean_depth layers of lean_width. Two
+  // ints, not a vector: a second vector in this aggregate set off GCC 12's -Wmaybe-uninitialized.
+  int lean_width, lean_depth;
   RolloutConfig rollout;
   PaperRow baseline, hnn;
 };
@@ -28,6 +31,9 @@ class NBodyTask : public Task {
                        settings_.trajectories, settings_.points);
   }
   TrainConfig train_config() const override { return settings_.train; }
+  std::vector<int> lean_hidden() const override {
+    return std::vector<int>(std::size_t(settings_.lean_depth), settings_.lean_width);
+  }
   RolloutConfig rollout_config() const override { return settings_.rollout; }
   /// Exact derivatives, no noise; the first 20% of points (whole trajectories) are the test set.
   Dataset build_dataset(std::uint64_t seed) const override {
@@ -63,6 +69,8 @@ std::unique_ptr<Task> make_two_body_task() {
       .points = 50,
       .t_end = 20.0,
       .train = {.steps = 10000, .batch_size = 200, .weight_decay = 0.0},
+      .lean_width = 64,
+      .lean_depth = 2,
       .rollout = {.trajectories = 15, .t_end = 20.0, .points = 1000},
       .baseline = {{3.2682e-5, 1.2e-6}, {2.9575e-5, 8.9e-7}, {6.3276e-2, 3.4e-2}},
       .hnn = {{2.9959e-6, 6.6e-8}, {2.8218e-6, 4.2e-8}, {3.8751e-5, 5.0e-6}}});
@@ -75,6 +83,8 @@ std::unique_ptr<Task> make_three_body_task() {
       .points = 20,
       .t_end = 5.0,
       .train = {.steps = 10000, .batch_size = 600, .weight_decay = 1e-4},
+      .lean_width = 64,
+      .lean_depth = 2,
       .rollout = {.trajectories = 15, .t_end = 20.0, .points = 100},
       .baseline = {{9.5573e-2, 6.6e-2}, {3.8000e-1, 4.2e-1}, {1.0906e+2, 7.7e+1}},
       .hnn = {{8.0346e-2, 2.1e-2}, {4.8809e-1, 4.8e-1}, {4.1926e-2, 3.4e-2}}});

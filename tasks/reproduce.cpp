@@ -101,6 +101,12 @@ std::string value_se(const json& row, const std::string& key) {
   return fmt::format("{:.4e} ± {:.1e}", v.get<double>(), se.get<double>());
 }
 
+// ", lean 32-32" after a lean run's dtype; nothing for the paper's widths.
+std::string widths_note(const json& row) {
+  if (row.value("preset", "paper") == "paper") return "";
+  return fmt::format(", {} {}", row["preset"].get<std::string>(), row.value("hidden", "?"));
+}
+
 }  // namespace
 
 std::string table1_markdown(const json& rows, double wall_seconds) {
@@ -127,10 +133,10 @@ std::string table1_markdown(const json& rows, double wall_seconds) {
     const auto both = [&](const std::string& key) {
       return value_se(b, key) + " / " + value_se(h, key);
     };
-    md += fmt::format("| {} | ours ({} steps, {}) | {} | {} | {} | {:.1f} s / {:.1f} s |\n", task,
-                      h["steps"].get<int>(), h["dtype"].get<std::string>(), both("train_loss"),
-                      both("test_loss"), both("energy_mse"), b["train_seconds"].get<double>(),
-                      h["train_seconds"].get<double>());
+    md += fmt::format("| {} | ours ({} steps, {}{}) | {} | {} | {} | {:.1f} s / {:.1f} s |\n", task,
+                      h["steps"].get<int>(), h["dtype"].get<std::string>(), widths_note(h),
+                      both("train_loss"), both("test_loss"), both("energy_mse"),
+                      b["train_seconds"].get<double>(), h["train_seconds"].get<double>());
     md += fmt::format("| | *paper* | {} | {} | {} | |\n", both("paper_train_loss"),
                       both("paper_test_loss"), both("paper_energy_mse"));
   }
@@ -154,7 +160,12 @@ json reproduce(const ReproduceOptions& o) {
     make_task(task);  // fail on a bad name before any work
     for (const char* model : kModels) {
       for (int seed = 0; seed < o.seeds; ++seed) {
-        RunOptions r{.task = task, .model = model, .seed = std::uint64_t(seed), .dtype = o.dtype};
+        RunOptions r;
+        r.task = task;
+        r.model = model;
+        r.seed = std::uint64_t(seed);
+        r.dtype = o.dtype;
+        r.preset = o.preset;
         r.steps = o.steps;
         r.threads = std::max(1, int(std::thread::hardware_concurrency()) / o.jobs);
         r.out = run_dir(o, task, model, seed);

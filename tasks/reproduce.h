@@ -13,6 +13,7 @@ struct ReproduceOptions {
   std::vector<std::string> tasks;  // empty: every task
   int seeds = 1;                   // seeds 0 .. seeds-1, averaged
   std::string dtype = "double";
+  std::string preset = "paper";  // paper | lean (each task's widths, see Task::lean_hidden)
   int jobs = 2;                    // runs trained at once (sharing the cores)
   std::optional<int> steps;        // override every task's step count (quick looks)
   std::filesystem::path out = "results";

@@ -1,6 +1,7 @@
 #include "tasks/run.h"
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <charconv>
 #include <chrono>
 #include <cmath>
@@ -32,7 +33,7 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 }
 
 TrainConfig resolve_config(const Task& task, const RunOptions& o) {
-  TrainConfig config = task.train_config();
+  TrainConfig config = train_config(task, o.preset);
   if (o.steps) config.steps = *o.steps;
   if (o.batch_size) config.batch_size = *o.batch_size;
   if (o.hidden) config.hidden = *o.hidden;
@@ -111,6 +112,7 @@ json run_settings(const Task& task, const RunOptions& o, const TrainConfig& conf
           {"model", o.model},
           {"seed", o.seed},
           {"dtype", o.dtype},
+          {"preset", o.preset},
           {"threads", o.threads},
           {"steps", config.steps},
           {"batch_size", config.batch_size},
@@ -173,6 +175,9 @@ void validate(const RunOptions& o) {
   nn::parse_model_kind(o.model);
   HNN_TASKS_CHECK(o.dtype == "float" || o.dtype == "double",
                   "--dtype must be float or double, got '{}'", o.dtype);
+  const std::vector<std::string> presets = preset_names();
+  HNN_TASKS_CHECK(std::find(presets.begin(), presets.end(), o.preset) != presets.end(),
+                  "--preset must be paper or lean, got '{}'", o.preset);
   HNN_TASKS_CHECK(o.threads >= 1 && o.threads <= 256, "--threads must be 1..256, got {}",
                   o.threads);
   HNN_TASKS_CHECK(!o.steps || *o.steps > 0, "--steps must be positive, got {}", *o.steps);
@@ -216,6 +221,7 @@ json run_training(const RunOptions& o) {
                   {"steps", config.steps},
                   {"batch_size", config.batch_size},
                   {"hidden", join(config.hidden)},
+                  {"preset", o.preset},
                   {"learning_rate", config.learning_rate},
                   {"weight_decay", config.weight_decay},
                   {"dtype", o.dtype},
@@ -249,6 +255,7 @@ LoadedRun load_run(const fs::path& run_dir, const std::string& data_file) {
                     saved.at("seed").dump());
     o.seed = saved.at("seed");
     o.dtype = saved.at("dtype");
+    o.preset = saved.value("preset", "paper");
     o.hidden = parse_widths(saved.at("hidden").get<std::string>());
   } catch (const std::exception& e) {
     throw Error(
@@ -289,6 +296,7 @@ RunOptions resume_options(const fs::path& run_dir) {
     o.model = r.at("model");
     o.seed = json_integer<std::uint64_t>(r.at("seed"), "seed");
     o.dtype = r.at("dtype");
+    o.preset = r.value("preset", "paper");  // checkpoints before the presets have none
     o.threads = json_integer<int>(r.at("threads"), "threads");
     o.steps = json_integer<int>(r.at("steps"), "steps");
     o.batch_size = json_integer<int>(r.at("batch_size"), "batch_size");

@@ -25,9 +25,10 @@ struct RunOptions {
   std::string model = "hnn";    // hnn | baseline
   std::uint64_t seed = 0;
   std::string dtype = "double";  // float | double
+  std::string preset = "paper";  // paper | lean: the task's widths (see train_config)
   int threads = 2;  // the engine's threads: fused kernels split each batch into row blocks
   std::optional<int> steps, batch_size;
-  std::optional<std::vector<int>> hidden;
+  std::optional<std::vector<int>> hidden;  // overrides the preset's widths
   std::optional<double> learning_rate;
   std::string data_file;  // measured-data tasks: another file of the same format
   std::filesystem::path out;

@@ -14,6 +14,18 @@ void Task::set_data_file(const std::string&) {
                           name()));
 }
 
+std::vector<std::string> preset_names() { return {"paper", "lean"}; }
+
+TrainConfig train_config(const Task& task, const std::string& preset) {
+  TrainConfig config = task.train_config();
+  if (preset == "lean") {
+    config.hidden = task.lean_hidden();
+  } else if (preset != "paper") {
+    throw Error(fmt::format("unknown preset '{}' (known: paper, lean)", preset));
+  }
+  return config;
+}
+
 std::vector<std::string> task_names() {
   return {"spring", "pendulum", "real-pendulum", "two-body", "three-body", "pixel-pendulum"};
 }

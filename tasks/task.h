@@ -54,6 +54,10 @@ class Task {
   /// One line for --help and reports.
   virtual std::string summary() const = 0;
   virtual TrainConfig train_config() const = 0;
+  /// The `lean` preset's hidden widths: the smallest model whose test loss and energy MSE are
+  /// within the noise of the paper's widths (issue 7's model-size sweep,
+  /// docs/speed_accuracy.md). By default the paper's widths (a task the sweep did not cover).
+  virtual std::vector<int> lean_hidden() const { return train_config().hidden; }
   virtual RolloutConfig rollout_config() const { return {}; }
   /// Deterministic: the same seed gives the same data, bit for bit.
   virtual Dataset build_dataset(std::uint64_t seed) const = 0;
@@ -66,6 +70,12 @@ class Task {
   /// Tasks on measured data read this file instead of the shipped copy.
   virtual void set_data_file(const std::string& path);
 };
+
+/// The training presets: "paper" (the paper's settings) and "lean" (lean_hidden's widths).
+std::vector<std::string> preset_names();
+
+/// The task's configuration under a preset; throws Error naming the known presets otherwise.
+TrainConfig train_config(const Task& task, const std::string& preset);
 
 /// The tasks by name: spring, pendulum, real-pendulum, two-body, three-body, pixel-pendulum.
 std::unique_ptr<Task> make_task(const std::string& name);

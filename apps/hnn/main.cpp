@@ -67,8 +67,8 @@ void train_until_done_or_stopped(tasks::RunOptions o) {
 // `hnn train --resume DIR`: the settings are the checkpoint's; only options that cannot change
 // the result may be given again.
 tasks::RunOptions resumed_options(const CLI::App& cmd, const std::string& dir, bool quiet) {
-  for (const char* name : {"task", "--model", "--steps", "--seed", "--dtype", "--batch", "--hidden",
-                           "--lr", "--data", "--out"}) {
+  for (const char* name : {"task", "--model", "--steps", "--seed", "--dtype", "--preset", "--batch",
+                           "--hidden", "--lr", "--data", "--out"}) {
     if (cmd.get_option(name)->count() > 0) {
       throw std::invalid_argument(fmt::format(
           "{} cannot be combined with --resume: a resumed run keeps its own settings", name));
@@ -107,6 +107,11 @@ void add_train_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--threads", options->threads, "Threads for matrix products")
       ->check(integer_in(1, 256))
+      ->capture_default_str();
+  cmd->add_option("--preset", options->preset,
+                  "Model widths: paper (the paper's 200-200) or lean (the smallest within the "
+                  "noise of paper's accuracy); --hidden overrides either")
+      ->check(CLI::IsMember(tasks::preset_names()))
       ->capture_default_str();
   cmd->add_option("--batch", *batch, "Minibatch size (0: full batch; default: the paper's)")
       ->check(integer_in(0, std::numeric_limits<int>::max()));
@@ -167,6 +172,9 @@ void add_reproduce_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--dtype", options->dtype, "float or double")
       ->check(CLI::IsMember({"float", "double"}))
+      ->capture_default_str();
+  cmd->add_option("--preset", options->preset, "Model widths of every run: paper or lean")
+      ->check(CLI::IsMember(tasks::preset_names()))
       ->capture_default_str();
   cmd->add_option("--jobs", options->jobs, "Runs trained at once")
       ->check(integer_in(1, 64))
