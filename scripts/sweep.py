@@ -15,8 +15,9 @@ Parts (all by default, in this order):
   depth         HNN (then baseline), depths 1 and 3 at width 200, double, seed 0
   seeds         seeds 1 and 2 of the paper's 200-200 and of the lean candidates (LEAN_CANDIDATES)
 Writes DIR/float_double.csv and DIR/model_size.csv (one row per run, with the 1-minute load
-average when it started), which scripts/plot_sweep.py reads. Default EXE: build-sweep/apps/hnn
-copied to DIR/hnn, so rebuilding the tree during a sweep does not change the program it runs.
+average when it started), which scripts/plot_sweep.py reads. Default EXE: build/apps/hnn (built
+by scripts/build.sh if missing) copied to DIR/hnn, so rebuilding the tree during a sweep does
+not change the program it runs.
 """
 
 import argparse
@@ -40,10 +41,10 @@ DEPTH_WIDTH = 200
 # depth parts), trained on two more seeds before one is offered as the `lean` preset.
 LEAN_CANDIDATES = {
     "spring": [[16, 16], [32, 32]],
-    "pendulum": [[16, 16], [32, 32]],
+    "pendulum": [[32, 32], [64, 64]],
     "real-pendulum": [[16, 16], [32, 32]],
     "two-body": [[32, 32], [64, 64]],
-    "three-body": [[64, 64], [128, 128]],
+    "three-body": [[32, 32], [64, 64]],
 }
 EXTRA_SEEDS = [1, 2]
 STARVED = 1.25      # wall / CPU time above which a run counts as starved (see starved())
@@ -167,7 +168,7 @@ def write_csv(path, rows):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--hnn", default=None, help="the hnn program (default: a copy of "
-                    "build-sweep/apps/hnn in OUT)")
+                    "build/apps/hnn in OUT, built first if missing)")
     ap.add_argument("--out", default="results/sweep")
     ap.add_argument("--parts", default="float_double,width,depth,seeds")
     ap.add_argument("--tasks", default=",".join(TASKS))
@@ -185,7 +186,9 @@ def main():
     if exe is None:
         exe = os.path.join(a.out, "hnn")
         if not os.path.exists(exe):
-            shutil.copy2("build-sweep/apps/hnn", exe)
+            if not os.path.exists("build/apps/hnn"):
+                subprocess.run(["scripts/build.sh"], check=True)
+            shutil.copy2("build/apps/hnn", exe)
     exe = os.path.abspath(exe)
 
     start = time.time()

@@ -18,7 +18,7 @@ class PendulumTask : public Task {
     return {.steps = 2000, .batch_size = 0, .weight_decay = 1e-4};
   }
   // The `lean` preset (docs/speed_accuracy.md, chart 4): within the noise of 200-200.
-  std::vector<int> lean_hidden() const override { return {64, 64}; }
+  std::vector<int> lean_hidden() const override { return {32, 32}; }
   Dataset build_dataset(std::uint64_t seed) const override {
     return oscillator_dataset(pendulum_, seed, {.trajectories = 50, .points = 45, .t_end = 3.0});
   }

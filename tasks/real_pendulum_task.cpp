@@ -21,7 +21,7 @@ class RealPendulumTask : public Task {
     return {.steps = 2000, .batch_size = 0, .weight_decay = 1e-5};
   }
   // The `lean` preset (docs/speed_accuracy.md, chart 4): within the noise of 200-200.
-  std::vector<int> lean_hidden() const override { return {64, 64}; }
+  std::vector<int> lean_hidden() const override { return {16, 16}; }
   Dataset build_dataset(std::uint64_t) const override {
     const physics::LipsonData data = physics::load_lipson(path_);
     Batch x, dxdt;

@@ -194,7 +194,7 @@ json reproduce(const ReproduceOptions& o) {
     pixel::write_comparison(run_dir(o, pixel::kTaskName, "baseline", 0),
                             run_dir(o, pixel::kTaskName, "hnn", 0), o.out / pixel::kTaskName);
   }
-  reversibility_report(o.out);
+  if (o.reversibility) reversibility_report(o.out);
   return table;
 }
 

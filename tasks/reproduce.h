@@ -18,6 +18,7 @@ struct ReproduceOptions {
   std::optional<int> steps;        // override every task's step count (quick looks)
   std::filesystem::path out = "results";
   bool quiet = false;
+  bool reversibility = true;  // also write reversibility.md/.json over every run
 };
 
 /// Runs everything into out/<task>/<model>[/seed-<s>], then writes out/table1.json and

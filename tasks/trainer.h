@@ -59,15 +59,15 @@ struct StopSignal {
 struct TrainHooks {
   bool quiet = false;                      // no progress output
   std::string label = "train";             // progress label
-  std::function<void(long step)> on_record;  // after each loss-curve point (checkpoints)
+  std::function<void(long step)> on_record{};  // after each loss-curve point (checkpoints)
   /// Checkpoints (tasks/train_checkpoint.h) go to this folder every `checkpoint_every` steps, at
   /// the last step, and when stopped; none when it is empty.
-  std::filesystem::path checkpoint_dir;
+  std::filesystem::path checkpoint_dir{};
   long checkpoint_every = 0;
   /// Continue from the checkpoint in checkpoint_dir instead of starting at step 0.
   bool resume = false;
   /// The run's settings, stored in every checkpoint (for `hnn train --resume`).
-  nlohmann::json run_settings;
+  nlohmann::json run_settings{};
   /// Polled after every step: when requested, training checkpoints and throws
   /// TrainingInterrupted.
   StopSignal* stop = nullptr;

@@ -42,14 +42,19 @@ TEST(Presets, PaperIsTheTasksOwnConfiguration) {
   }
 }
 
-// Lean changes the widths only, and to a smaller model on every swept task.
+// Lean changes the widths only, and to a smaller model on every swept task but three-body
+// (whose smaller models' energy error blew up on some seed: its lean model is the paper's).
 TEST(Presets, LeanIsASmallerModelWithEverythingElseThePapers) {
   for (const std::string& name : testing::state_tasks()) {
     const auto task = make_task(name);
     const TrainConfig paper = train_config(*task, "paper"), lean = train_config(*task, "lean");
     EXPECT_EQ(lean.hidden, task->lean_hidden()) << name;
     const int dim = int(task->build_dataset(0).train_x.cols());
-    EXPECT_LT(hnn_parameters(dim, lean.hidden), hnn_parameters(dim, paper.hidden)) << name;
+    if (name == "three-body") {
+      EXPECT_EQ(lean.hidden, paper.hidden);
+    } else {
+      EXPECT_LT(hnn_parameters(dim, lean.hidden), hnn_parameters(dim, paper.hidden)) << name;
+    }
     EXPECT_EQ(lean.steps, paper.steps) << name;
     EXPECT_EQ(lean.batch_size, paper.batch_size) << name;
     EXPECT_EQ(lean.learning_rate, paper.learning_rate) << name;

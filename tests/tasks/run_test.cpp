@@ -4,6 +4,7 @@
 
 #include "tasks/run.h"
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -81,8 +82,9 @@ void expect_loss_curve(const fs::path& path, int steps) {
 
 std::string rollout_header(int dim) {
   std::string h = "traj,t";
-  for (const char* which : {"true", "pred"})
-    for (int k = 0; k < dim; ++k) h += "," + std::string(which) + "_" + std::to_string(k);
+  for (const char* which : {"true", "pred"}) {
+    for (int k = 0; k < dim; ++k) h += fmt::format(",{}_{}", which, k);
+  }
   return h + ",true_energy,pred_energy,learned_h";
 }
 
@@ -102,9 +104,11 @@ void expect_rollout_csv(const fs::path& path, const TaskShape& shape, bool has_h
     const double t = std::stod(cells[1]);
     EXPECT_NEAR(t, shape.t_end * double(k) / (shape.rollout_points - 1), 1e-6) << i;
     EXPECT_FALSE(cells[2 + 2 * std::size_t(shape.dim)].empty()) << "true_energy, line " << i;
-    if (!has_h) EXPECT_TRUE(cells.back().empty()) << "learned_h of a baseline, line " << i;
-    if (has_h && !cells[2 + std::size_t(shape.dim)].empty())  // a prediction: its H too
+    if (!has_h) {
+      EXPECT_TRUE(cells.back().empty()) << "learned_h of a baseline, line " << i;
+    } else if (!cells[2 + std::size_t(shape.dim)].empty()) {  // a prediction: its H too
       EXPECT_FALSE(cells.back().empty()) << "learned_h, line " << i;
+    }
   }
 }
 
@@ -275,6 +279,11 @@ TEST(Reproduce, TableAveragesSeedsAndCarriesThePapersValues) {
   EXPECT_NE(md.find("| real-pendulum |"), std::string::npos) << md;
   EXPECT_NE(md.find("2.7455e-03"), std::string::npos) << md;  // the paper's baseline train loss
   EXPECT_NE(md.find("9.2376e-03"), std::string::npos) << md;  // ... and HNN train loss
+  // The reversibility report over the runs: a row per model, seed 0's run.
+  const std::string rev = read_text(dir / "reversibility.md");
+  EXPECT_NE(rev.find("| real-pendulum | baseline |"), std::string::npos) << rev;
+  EXPECT_NE(rev.find("| real-pendulum | hnn |"), std::string::npos) << rev;
+  EXPECT_EQ(read_json(dir / "reversibility.json").size(), 2u);
 }
 
 TEST(Table1Markdown, OneRowOfOursAndOneOfThePapersPerTask) {
