@@ -190,8 +190,9 @@ def read_table1(results):
 # Drawing helpers
 
 
-def save(fig, results, stem):
-    """Writes stem.png and stem.svg atomically (temp file in the same folder, then rename)."""
+def save(fig, results, stem, **savefig_options):
+    """Writes stem.png and stem.svg atomically (temp file in the same folder, then rename).
+    savefig_options go to matplotlib (e.g. bbox_inches="tight")."""
     written = []
     for ext in ("png", "svg"):
         final = os.path.join(results, f"{stem}.{ext}")
@@ -199,7 +200,7 @@ def save(fig, results, stem):
         os.close(fd)
         try:
             fig.savefig(tmp, format=ext, dpi=150,  # no date in the SVG: same data, same bytes
-                        metadata={"Date": None} if ext == "svg" else None)
+                        metadata={"Date": None} if ext == "svg" else None, **savefig_options)
             os.chmod(tmp, 0o666 & ~UMASK)  # mkstemp makes 0600; give the usual permissions
             os.replace(tmp, final)
         finally:

@@ -30,6 +30,9 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402  (the backend must be chosen first)
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import plot  # noqa: E402  (the atomic PNG+SVG writer)
 from matplotlib import ticker  # noqa: E402
 
 plt.rcParams.update({"svg.fonttype": "none", "svg.hashsalt": "hnn", "font.size": 9,
@@ -57,12 +60,7 @@ def num(r, key):
 
 
 def save(fig, directory, name):
-    for ext in ("png", "svg"):
-        path = os.path.join(directory, f"{name}.{ext}")
-        fig.savefig(path, dpi=150 if ext == "png" else None, bbox_inches="tight",
-                    metadata={"Date": None} if ext == "svg" else None)
-        print(path)
-    plt.close(fig)
+    plot.save(fig, directory, name, bbox_inches="tight")
 
 
 def plain_log_ticks(axis):
