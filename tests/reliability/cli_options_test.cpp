@@ -121,6 +121,8 @@ TEST(CliOptions, BadCommandsAndOtherSubcommandsGetOneLine) {
       {{"reproduce", "--jobs", "100"}, "--jobs: expected an integer from 1 to 64, got '100'"},
       {{"reproduce", "--steps", "0"}, "--steps: expected an integer >= 1, got '0'"},
       {{"reproduce", "--dtype", "half"}, "--dtype: half not in {float,double}"},
+      {{"reproduce", "--no-reversibility=x", "--out", (dir / "results").string()},
+       "Could not convert: --no-reversibility = x"},
       {{"reproduce", "--tasks", "spring,nope", "--out", (dir / "results").string()},
        "unknown task 'nope' (known: spring, pendulum, real-pendulum, two-body, three-body, "
        "pixel-pendulum)"},
