@@ -33,7 +33,7 @@ TITLES = {"spring": "Ideal mass-spring", "pendulum": "Ideal pendulum",
 MODELS = ["baseline", "hnn"]
 COLORS = {"truth": "black", "baseline": "tab:red", "hnn": "tab:blue"}
 LABELS = {"truth": "Ground truth", "baseline": "Baseline NN", "hnn": "Hamiltonian NN"}
-NO_ROLLOUT_CHARTS = {"pixel-pendulum"}  # its rollouts are frames; not charted yet
+FRAME_ROLLOUTS = {"pixel-pendulum"}  # rollouts of frames: Figure 4 in plot_pixel.py
 UMASK = os.umask(0o022)
 os.umask(UMASK)
 
@@ -512,9 +512,8 @@ def draw_rollout_charts(results, task, runs):
     if not any(runs.get(m) and runs[m]["rollout"] for m in MODELS):
         note(f"{task}: no rollout.csv, rollout charts skipped")
         return []
-    if task in NO_ROLLOUT_CHARTS:
-        note(f"{task}: rollout charts not implemented yet, skipped")
-        return []
+    if task in FRAME_ROLLOUTS:
+        return []  # scripts/plot_pixel.py draws them
     rolls, truth = rollouts_of(runs)
     d = truth["true"].shape[1]
     if d == 2:

@@ -174,7 +174,7 @@ def write_lean(stats, tasks, directory):
               "speedup_wall", "speedup_cpu", "test_loss", "test_loss_se", "energy_mse",
               "energy_mse_se"]
     chosen = {}
-    with open(path, "w", newline="") as f:
+    with open(path + ".tmp", "w", newline="") as f:  # renamed when complete
         w = csv.DictWriter(f, fieldnames=fields, lineterminator="\n")
         w.writeheader()
         for task in tasks:
@@ -193,6 +193,7 @@ def write_lean(stats, tasks, directory):
                     "test_loss": f"{s['test_loss'][0]:.5g}", "test_loss_se": f"{s['test_loss'][1]:.2g}",
                     "energy_mse": f"{s['energy_mse'][0]:.5g}",
                     "energy_mse_se": f"{s['energy_mse'][1]:.2g}"})
+    os.replace(path + ".tmp", path)
     print(path)
     return chosen
 
@@ -288,14 +289,16 @@ def main():
     sweep = sys.argv[1] if len(sys.argv) > 1 else "results/sweep"
     out = sys.argv[2] if len(sys.argv) > 2 else "docs/charts"
     os.makedirs(out, exist_ok=True)
-    for name, plot in [("float_double", plot_float_double), ("model_size", plot_model_size)]:
+    for name, draw in [("float_double", plot_float_double), ("model_size", plot_model_size)]:
         path = os.path.join(sweep, name + ".csv")
         if not os.path.exists(path):
             print(f"plot_sweep: no {path}, skipping {name}", file=sys.stderr)
             continue
         if os.path.abspath(os.path.dirname(path)) != os.path.abspath(out):
-            shutil.copy(path, os.path.join(out, name + ".csv"))
-        plot(read_csv(path), out)
+            copy = os.path.join(out, name + ".csv")
+            shutil.copy(path, copy + ".tmp")
+            os.replace(copy + ".tmp", copy)
+        draw(read_csv(path), out)
 
 
 if __name__ == "__main__":

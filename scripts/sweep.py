@@ -134,9 +134,11 @@ def train(exe, task, model, dtype, hidden, seed, folder, dry_run):
     if result.returncode != 0:
         sys.exit(f"sweep: {task} {model} {dtype} {hidden_tag(hidden)} seed {seed} failed "
                  f"(exit {result.returncode}): {result.stderr.strip()}")
-    with open(os.path.join(folder, "sweep.json"), "w") as f:
+    path = os.path.join(folder, "sweep.json")
+    with open(path + ".tmp", "w") as f:  # renamed when complete: a resumed sweep reads it
         json.dump({"load1": load1, "wall_seconds": time.time() - start, "cpu_seconds": cpu,
                    "attempts": attempts}, f)
+    os.replace(path + ".tmp", path)
 
 
 def row(part, task, model, dtype, hidden, seed, folder):
@@ -158,10 +160,11 @@ def row(part, task, model, dtype, hidden, seed, folder):
 
 
 def write_csv(path, rows):
-    with open(path, "w", newline="") as f:
+    with open(path + ".tmp", "w", newline="") as f:  # renamed when complete
         w = csv.DictWriter(f, fieldnames=FIELDS, lineterminator="\n")
         w.writeheader()
         w.writerows(rows)
+    os.replace(path + ".tmp", path)
     print(f"sweep: {path} ({len(rows)} rows)")
 
 

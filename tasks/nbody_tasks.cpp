@@ -27,8 +27,8 @@ class NBodyTask : public Task {
   std::string name() const override { return settings_.bodies == 2 ? "two-body" : "three-body"; }
   std::string summary() const override {
     return fmt::format("task {}: {} bodies under gravity, {} trajectories of {} points",
-                       settings_.bodies == 2 ? "4" : "4b", settings_.bodies,
-                       settings_.trajectories, settings_.points);
+                       settings_.bodies == 2 ? "4" : "4b", settings_.bodies, settings_.trajectories,
+                       settings_.points);
   }
   TrainConfig train_config() const override { return settings_.train; }
   std::vector<int> lean_hidden() const override {

@@ -2,10 +2,10 @@
 // The paper's Table 1: baseline and HNN trained on every task, ours beside the paper's values.
 
 #include <filesystem>
+#include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 namespace hnn::tasks {
 
@@ -14,8 +14,8 @@ struct ReproduceOptions {
   int seeds = 1;                   // seeds 0 .. seeds-1, averaged
   std::string dtype = "double";
   std::string preset = "paper";  // paper | lean (each task's widths, see Task::lean_hidden)
-  int jobs = 2;                    // runs trained at once (sharing the cores)
-  std::optional<int> steps;        // override every task's step count (quick looks)
+  int jobs = 2;                  // runs trained at once (sharing the cores)
+  std::optional<int> steps;      // override every task's step count (quick looks)
   std::filesystem::path out = "results";
   bool quiet = false;
   bool reversibility = true;  // also write reversibility.md/.json over every run

@@ -57,8 +57,8 @@ struct StopSignal {
 };
 
 struct TrainHooks {
-  bool quiet = false;                      // no progress output
-  std::string label = "train";             // progress label
+  bool quiet = false;                          // no progress output
+  std::string label = "train";                 // progress label
   std::function<void(long step)> on_record{};  // after each loss-curve point (checkpoints)
   /// Checkpoints (tasks/train_checkpoint.h) go to this folder every `checkpoint_every` steps, at
   /// the last step, and when stopped; none when it is empty.
@@ -78,9 +78,8 @@ struct TrainHooks {
 /// parameters, bit for bit, as one never stopped. Throws TrainingDiverged at the first step whose
 /// loss is not finite (the last checkpoint, if any, is kept).
 template <typename T>
-TrainResult train_model(nn::DynamicsModel<T>& model, const Dataset& data,
-                        const TrainConfig& config, std::uint64_t seed,
-                        const TrainHooks& hooks = {});
+TrainResult train_model(nn::DynamicsModel<T>& model, const Dataset& data, const TrainConfig& config,
+                        std::uint64_t seed, const TrainHooks& hooks = {});
 
 /// Mean squared error of the model's field on (x, dxdt), computed in chunks without a graph.
 template <typename T>

@@ -199,8 +199,8 @@ TEST(CliEvaluateAndRollout, WorkOnASavedRun) {
 TEST(CliReproduce, WritesTable1WithThePapersValues) {
   TempDir dir("results");
   // The reversibility report (seconds per spring model) is covered by tasks.Reproduce.*.
-  const Result r = hnn("reproduce --tasks spring,real-pendulum --steps 20 --no-reversibility --out " +
-                       dir.str());
+  const Result r = hnn(
+      "reproduce --tasks spring,real-pendulum --steps 20 --no-reversibility --out " + dir.str());
   ASSERT_EQ(r.exit_code, 0) << r.out;
   ASSERT_TRUE(fs::is_regular_file(dir.path() / "table1.md"));
   ASSERT_TRUE(fs::is_regular_file(dir.path() / "table1.json"));
