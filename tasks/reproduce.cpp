@@ -8,12 +8,10 @@
 #include <mutex>
 #include <thread>
 
-#include "tasks/files.h"
-#include "tasks/pixel_pendulum.h"
-#include "tasks/reversibility.h"
+#include "tasks/report/atomic_file.h"
+#include "tasks/report/reversibility_table.h"
+#include "tasks/report/table1.h"
 #include "tasks/run.h"
-#include "tasks/task.h"
-#include "tasks/task_library.h"
 
 namespace hnn::tasks {
 
@@ -22,13 +20,13 @@ using nlohmann::json;
 
 namespace {
 
-const char* const kModels[] = {"baseline", "hnn"};
+constexpr nn::ModelKind kModels[] = {nn::ModelKind::kBaseline, nn::ModelKind::kHnn};
 const char* const kAveraged[] = {"train_loss", "train_loss_se", "test_loss",     "test_loss_se",
                                  "energy_mse", "energy_mse_se", "train_seconds", "eval_seconds"};
 
-fs::path run_dir(const ReproduceOptions& o, const std::string& task, const std::string& model,
+fs::path run_dir(const ReproduceOptions& o, const std::string& task, nn::ModelKind model,
                  int seed) {
-  const fs::path dir = o.out / task / model;
+  const fs::path dir = o.out / task / std::string(nn::to_string(model));
   return o.seeds == 1 ? dir : dir / fmt::format("seed-{}", seed);
 }
 
@@ -46,7 +44,7 @@ std::vector<json> run_all(const std::vector<RunOptions>& runs, int jobs) {
         const std::lock_guard lock(print);
         fmt::print(
             stderr, "  {:<14} {:<9} seed {}  test loss {:.4e}  energy MSE {}  ({:.1f} s)\n",
-            runs[i].task, runs[i].model, runs[i].seed,
+            runs[i].task, nn::to_string(runs[i].model), runs[i].seed,
             results[i]["test_loss"].is_number() ? results[i]["test_loss"].get<double>() : NAN,
             results[i]["energy_mse"].is_number()
                 ? fmt::format("{:.4e}", results[i]["energy_mse"].get<double>())
@@ -67,7 +65,7 @@ std::vector<json> run_all(const std::vector<RunOptions>& runs, int jobs) {
 }
 
 // One row of table1.json: the mean over seeds of each metric, with the paper's values.
-json table_row(const Task& task, const std::string& model, const std::vector<json>& seeds) {
+json table_row(const Task& task, nn::ModelKind model, const std::vector<json>& seeds) {
   json row = seeds.front();
   for (const char* key : kAveraged) {
     double sum = 0;
@@ -93,63 +91,16 @@ json table_row(const Task& task, const std::string& model, const std::vector<jso
   return row;
 }
 
-std::string value_se(const json& row, const std::string& key) {
-  const json& v = row[key];
-  const json& se = row[key + "_se"];
-  if (!v.is_number()) return "n/a";
-  if (!se.is_number()) return fmt::format("{:.4e}", v.get<double>());
-  return fmt::format("{:.4e} ± {:.1e}", v.get<double>(), se.get<double>());
-}
-
-// ", lean 32-32" after a lean run's dtype; nothing for the paper's widths.
-std::string widths_note(const json& row) {
-  if (row.value("preset", "paper") == "paper") return "";
-  return fmt::format(", {} {}", row["preset"].get<std::string>(), row.value("hidden", "?"));
+std::vector<std::string> table_notes(const std::vector<std::string>& tasks) {
+  std::vector<std::string> notes;
+  for (const std::string& task : tasks) {
+    const std::string note = make_task(task)->table_note();
+    if (!note.empty()) notes.push_back(note);
+  }
+  return notes;
 }
 
 }  // namespace
-
-std::string table1_markdown(const json& rows, double wall_seconds) {
-  std::map<std::string, std::map<std::string, json>> by_task;
-  std::vector<std::string> order;
-  for (const json& r : rows) {
-    const std::string task = r["task"];
-    if (!by_task.count(task)) order.push_back(task);
-    by_task[task][r["model"].get<std::string>()] = r;
-  }
-  std::string md = fmt::format(
-      "# Table 1, reproduced\n\n"
-      "Mean ± standard error, baseline / HNN, in the paper's units (not rescaled); for each "
-      "task, our row and then the paper's (*paper*). Losses: mean squared error of dx/dt "
-      "over the whole split; energy: MSE between the true energy along true and learned rollouts "
-      "(adaptive RK45, rtol 1e-9).\n\n"
-      "| task | source | train loss (baseline / HNN) | test loss (baseline / HNN) | energy MSE "
-      "(baseline / HNN) | train time (baseline / HNN) |\n"
-      "| --- | --- | --- | --- | --- | --- |\n");
-  for (const std::string& task : order) {
-    const json& b = by_task[task]["baseline"];
-    const json& h = by_task[task]["hnn"];
-    if (b.is_null() || h.is_null()) continue;
-    const auto both = [&](const std::string& key) {
-      return value_se(b, key) + " / " + value_se(h, key);
-    };
-    md += fmt::format("| {} | ours ({} steps, {}{}) | {} | {} | {} | {:.1f} s / {:.1f} s |\n", task,
-                      h["steps"].get<int>(), h["dtype"].get<std::string>(), widths_note(h),
-                      both("train_loss"), both("test_loss"), both("energy_mse"),
-                      b["train_seconds"].get<double>(), h["train_seconds"].get<double>());
-    md += fmt::format("| | *paper* | {} | {} | {} | |\n", both("paper_train_loss"),
-                      both("paper_test_loss"), both("paper_energy_mse"));
-  }
-  if (by_task.count(pixel::kTaskName)) {
-    md +=
-        "\nPixel pendulum: losses are the combined ae + cc + 0.1 hnn per frame pair; energy MSE "
-        "is between the true Gym state's energy and the energy of the angle and velocity "
-        "recovered from the decoded frames of 200-frame latent rollouts (dopri5) from the test "
-        "trials (see energy_mse_frames_floor in its metrics.json for the recovery's own error).\n";
-  }
-  md += fmt::format("\nWall time of the whole reproduction: {:.1f} s.\n", wall_seconds);
-  return md;
-}
 
 json reproduce(const ReproduceOptions& o) {
   HNN_TASKS_CHECK(o.seeds >= 1, "--seeds must be at least 1, got {}", o.seeds);
@@ -158,7 +109,7 @@ json reproduce(const ReproduceOptions& o) {
   std::vector<RunOptions> runs;
   for (const std::string& task : tasks) {
     make_task(task);  // fail on a bad name before any work
-    for (const char* model : kModels) {
+    for (const nn::ModelKind model : kModels) {
       for (int seed = 0; seed < o.seeds; ++seed) {
         RunOptions r;
         r.task = task;
@@ -188,14 +139,28 @@ json reproduce(const ReproduceOptions& o) {
     table.push_back(table_row(*make_task(runs[i].task), runs[i].model, seeds));
   }
   write_file_atomic(o.out / "table1.json", table.dump(2) + "\n");
-  write_file_atomic(o.out / "table1.md", table1_markdown(table, wall));
-  // What the HNN makes possible: Figure 4's animation, and reversibility on every run.
-  if (std::find(tasks.begin(), tasks.end(), pixel::kTaskName) != tasks.end()) {
-    pixel::write_comparison(run_dir(o, pixel::kTaskName, "baseline", 0),
-                            run_dir(o, pixel::kTaskName, "hnn", 0), o.out / pixel::kTaskName);
+  write_file_atomic(o.out / "table1.md", table1_markdown(table, wall, table_notes(tasks)));
+  // What the HNN makes possible: the tasks' comparison figures, and reversibility on every run.
+  for (const std::string& task : tasks) {
+    make_task(task)->write_comparison(run_dir(o, task, nn::ModelKind::kBaseline, 0),
+                                      run_dir(o, task, nn::ModelKind::kHnn, 0), o.out / task);
   }
   if (o.reversibility) reversibility_report(o.out);
   return table;
+}
+
+json reversibility_report(const fs::path& results, const ReversibilityOptions& options) {
+  json rows = json::array();
+  for (const std::string& task : task_names()) {
+    for (const nn::ModelKind model : kModels) {
+      fs::path dir = results / task / std::string(nn::to_string(model));
+      if (!fs::exists(dir / "metrics.json")) dir /= "seed-0";
+      if (fs::exists(dir / "metrics.json")) rows.push_back(reversibility(dir, options));
+    }
+  }
+  write_file_atomic(results / "reversibility.json", rows.dump(2) + "\n");
+  write_file_atomic(results / "reversibility.md", reversibility_markdown(rows));
+  return rows;
 }
 
 }  // namespace hnn::tasks

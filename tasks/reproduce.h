@@ -7,13 +7,16 @@
 #include <string>
 #include <vector>
 
+#include "tasks/evaluate/reversibility.h"
+#include "tasks/options.h"
+
 namespace hnn::tasks {
 
 struct ReproduceOptions {
   std::vector<std::string> tasks;  // empty: every task
   int seeds = 1;                   // seeds 0 .. seeds-1, averaged
-  std::string dtype = "double";
-  std::string preset = "paper";  // paper | lean (each task's widths, see Task::lean_hidden)
+  Dtype dtype = Dtype::kDouble;
+  Preset preset = Preset::kPaper;  // each task's widths, see Task::lean_hidden
   int jobs = 2;                  // runs trained at once (sharing the cores)
   std::optional<int> steps;      // override every task's step count (quick looks)
   std::filesystem::path out = "results";
@@ -25,7 +28,9 @@ struct ReproduceOptions {
 /// out/table1.md. Returns table1.json's content.
 nlohmann::json reproduce(const ReproduceOptions& options);
 
-/// table1.md from table1.json's content.
-std::string table1_markdown(const nlohmann::json& rows, double wall_seconds);
+/// Every run under `results` (results/<task>/<model>[/seed-0]): reversibility.json in each, and
+/// results/reversibility.json and reversibility.md side by side for the models.
+nlohmann::json reversibility_report(const std::filesystem::path& results,
+                                    const ReversibilityOptions& options = {});
 
 }  // namespace hnn::tasks

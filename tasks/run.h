@@ -1,69 +1,50 @@
 #pragma once
-// One training run end to end: build the task's data, train a model, evaluate it, and write
-// the run folder (metrics.json, loss_curve.csv, rollout.csv, params.bin).
+// A run end to end, the same for every task: open the task's data, train with the training
+// loop (checkpoints, resume, stop), evaluate, and write the run folder (metrics.json,
+// loss_curve.csv, params.bin and the task's own files). And a finished run loaded back, to
+// evaluate again, roll out or measure reversibility.
 
-#include <cstdint>
 #include <filesystem>
-#include <optional>
-#include <string>
-#include <vector>
-
+#include <memory>
 #include <nlohmann/json.hpp>
+#include <string>
 
-#include "nn/dynamics.h"
+#include "tasks/evaluate/reversibility.h"
+#include "tasks/options.h"
 #include "tasks/task.h"
 
 namespace hnn::tasks {
-
-struct StopSignal;
-
-/// The widest hidden layer a run may ask for (a typo like 20000 would need gigabytes).
-inline constexpr int kMaxWidth = 4096;
-
-struct RunOptions {
-  std::string task;
-  std::string model = "hnn";    // hnn | baseline
-  std::uint64_t seed = 0;
-  std::string dtype = "double";  // float | double
-  std::string preset = "paper";  // paper | lean: the task's widths (see train_config)
-  int threads = 2;  // the engine's threads: fused kernels split each batch into row blocks
-  std::optional<int> steps, batch_size;
-  std::optional<std::vector<int>> hidden;  // overrides the preset's widths
-  std::optional<double> learning_rate;
-  std::string data_file;  // measured-data tasks: another file of the same format
-  std::filesystem::path out;
-  bool quiet = false;
-  /// Training checkpoints into out/checkpoint every this many steps (default: a tenth of the
-  /// steps), at the end, and when stopped.
-  std::optional<long> checkpoint_every;
-  /// Continue the run in `out` from its last checkpoint (see resume_options).
-  bool resume = false;
-  /// Polled by the training loop (e.g. set on SIGINT): checkpoint and stop after the step.
-  StopSignal* stop = nullptr;
-};
 
 /// Trains and evaluates one model; writes the run folder `options.out` and returns metrics.json's
 /// content. Throws on bad options or data (nothing half-written is left: each file is atomic).
 nlohmann::json run_training(const RunOptions& options);
 
-/// A finished run loaded back: its options, task, data and model (in double).
+/// A finished run loaded back: its settings, its task and the run (data and trained model).
 struct LoadedRun {
-  RunOptions options;
+  RunSettings settings;
   std::unique_ptr<Task> task;
-  Dataset data;
-  std::unique_ptr<nn::DynamicsModel<double>> model;
+  std::unique_ptr<TaskRun> run;  // refers to `task`: declared after it, destroyed before it
 };
 
-/// Reads run_dir/metrics.json and run_dir/params.bin (rebuilding the task's data from its seed).
+/// Reads run_dir/metrics.json and run_dir/params.bin (rebuilding the task's data from its seed);
+/// `data_file` replaces the run's own (measured-data tasks).
 LoadedRun load_run(const std::filesystem::path& run_dir, const std::string& data_file = "");
 
-/// Evaluates the parameters saved in a run folder again (same task, seed and data), returning
-/// the metrics without retraining.
+/// The metrics of the parameters saved in a run folder, again (same task, seed and data); with
+/// write_files, the evaluation's files are written again too.
 nlohmann::json evaluate_run(const std::filesystem::path& run_dir, const std::string& data_file,
                             bool write_files);
 
-/// Checks option values before any work: names the first bad one.
-void validate(const RunOptions& options);
+/// `hnn rollout`: writes the CSV of TaskRun::rollout_csv to `out` (default
+/// RUN/rollout_<integrator>.csv) and returns its path.
+std::filesystem::path write_rollout(const std::filesystem::path& run_dir,
+                                    const RolloutRequest& request,
+                                    const std::filesystem::path& out = {});
+
+/// Reversibility of a run's learned field from its rollout states (t_end 0: the run's rollout
+/// span); writes run_dir/reversibility.json and returns it.
+nlohmann::json reversibility(const std::filesystem::path& run_dir,
+                             const ReversibilityOptions& options = {});
 
 /// The options of the run in `run_dir`, read from its last checkpoint, with resume set: passed
 /// to run_training, it continues that run and ends as the uninterrupted run would have.

@@ -1,43 +1,23 @@
 #pragma once
-// A task is one experiment of the paper: its dataset, its training configuration (the paper's
-// settings as defaults), and what its evaluation needs (the true system and rollout settings).
+// A task is one experiment: its defaults (the paper's settings), its Table 1 row, and how a run
+// of it goes. Every task, the pixel pendulum included, is registered by name (make_task) and
+// offers the same entry points through TaskRun: build the data, train, evaluate, save and load,
+// roll out. The flow of a run (tasks/run.h): task -> data -> train -> evaluate -> report.
 
-#include <cstdint>
+#include <filesystem>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <optional>
-#include <random>
 #include <string>
 #include <vector>
 
-#include "physics/system.h"
+#include "nn/dynamics.h"
+#include "physics/types.h"
+#include "tasks/error.h"
+#include "tasks/options.h"
+#include "tasks/train/loop.h"
 
 namespace hnn::tasks {
-
-using physics::Batch;
-
-/// States and their time derivatives, split into train and test (rows are samples).
-struct Dataset {
-  Batch train_x, train_dxdt, test_x, test_dxdt;
-};
-
-/// How a model is trained. Every field can be overridden from the command line.
-struct TrainConfig {
-  int steps = 2000;
-  int batch_size = 0;  // 0: full batch
-  double learning_rate = 1e-3;
-  double weight_decay = 0.0;
-  std::vector<int> hidden = {200, 200};
-  int record_every = 0;  // loss-curve interval; 0 picks about 100 points
-};
-
-/// How rollouts for the energy metric are made.
-struct RolloutConfig {
-  int trajectories = 15;
-  double t_end = 20.0;
-  int points = 100;
-  double rtol = 1e-9;
-  double atol = 1e-12;
-};
 
 /// One model's published numbers (reference implementation, Table 1): mean and standard error.
 struct PaperValue {
@@ -47,37 +27,70 @@ struct PaperRow {
   PaperValue train_loss, test_loss, energy_mse;
 };
 
+/// `hnn rollout`: the learned model's paths (and the truth's) from test states.
+struct RolloutRequest {
+  std::string integrator = "dopri5";
+  double dt = 1e-2, rtol = 1e-9;
+  std::optional<double> t_end;  // default: the evaluation's rollout span
+  int points = 200, trajectories = 5;
+};
+
+/// One run of a task: its data (built when the run is opened) and its model.
+class TaskRun {
+ public:
+  virtual ~TaskRun() = default;
+  /// Trains a fresh model, initialised from the run's seed, with the training loop.
+  virtual TrainResult train(const LoopOptions& loop) = 0;
+  /// The trained model's parameters, in the run's dtype (nn's parameter file).
+  virtual void save(const std::filesystem::path& params) const = 0;
+  virtual void load(const std::filesystem::path& params) = 0;
+  /// The metrics of metrics.json; with a folder, also the task's evaluation files.
+  virtual nlohmann::json evaluate(const RunFolder* folder) const = 0;
+  /// The CSV of `hnn rollout`.
+  virtual std::string rollout_csv(const RolloutRequest& request) const = 0;
+
+  /// The learned field (in double) and the states its rollouts start from: the phase space, or
+  /// the latent space of a task that learns one. For reversibility and the like.
+  virtual const nn::DynamicsModel<double>& dynamics() const = 0;
+  virtual physics::Batch rollout_states(int count) const = 0;
+  /// The span of the evaluation's rollouts, in the dynamics' time unit.
+  virtual double rollout_span() const = 0;
+  /// "state" (phase space) or "latent".
+  virtual std::string space() const { return "state"; }
+};
+
 class Task {
  public:
   virtual ~Task() = default;
   virtual std::string name() const = 0;
   /// One line for --help and reports.
   virtual std::string summary() const = 0;
+  /// The paper's training settings.
   virtual TrainConfig train_config() const = 0;
   /// The `lean` preset's hidden widths: the smallest model whose test loss and energy MSE are
-  /// within the noise of the paper's widths (issue 7's model-size sweep,
-  /// docs/speed_accuracy.md). By default the paper's widths (a task the sweep did not cover).
+  /// within the noise of the paper's widths (the model-size sweep, docs/speed_accuracy.md). By
+  /// default the paper's widths (a task the sweep did not cover).
   virtual std::vector<int> lean_hidden() const { return train_config().hidden; }
-  virtual RolloutConfig rollout_config() const { return {}; }
-  /// Deterministic: the same seed gives the same data, bit for bit.
-  virtual Dataset build_dataset(std::uint64_t seed) const = 0;
-  /// The ground truth for rollouts and energies (the fitted H for measured data).
-  virtual const physics::System& truth() const = 0;
-  /// Initial states of the energy-metric rollouts.
-  virtual Batch rollout_states(const Dataset& data, std::mt19937_64& rng) const = 0;
-  /// The paper's Table 1 row for "baseline" or "hnn".
-  virtual PaperRow paper(const std::string& model) const = 0;
-  /// Tasks on measured data read this file instead of the shipped copy.
-  virtual void set_data_file(const std::string& path);
+  /// The paper's Table 1 row of a model.
+  virtual PaperRow paper(nn::ModelKind model) const = 0;
+  /// A paragraph under Table 1 when this task's metrics mean something particular.
+  virtual std::string table_note() const { return ""; }
+  /// A figure comparing a baseline run and an HNN run of this task (folders of run_training)
+  /// into `out`, for `hnn reproduce`; by default none.
+  virtual void write_comparison(const std::filesystem::path& baseline_run,
+                                const std::filesystem::path& hnn_run,
+                                const std::filesystem::path& out) const;
+  /// Whether --data FILE applies (tasks on measured data).
+  virtual bool reads_data_file() const { return false; }
+  /// Checks the task's own settings (RunSettings::task_settings); throws Error naming an unknown
+  /// key or a bad value. By default a task has none.
+  virtual void check_task_settings(const nlohmann::json& settings) const;
+  /// Builds the run's data (deterministic: the same settings give the same data, bit for bit).
+  virtual std::unique_ptr<TaskRun> open(const RunSettings& settings) const = 0;
 };
 
-/// The training presets: "paper" (the paper's settings) and "lean" (lean_hidden's widths).
-std::vector<std::string> preset_names();
-
-/// The task's configuration under a preset; throws Error naming the known presets otherwise.
-TrainConfig train_config(const Task& task, const std::string& preset);
-
 /// The tasks by name: spring, pendulum, real-pendulum, two-body, three-body, pixel-pendulum.
+/// Throws Error naming the known tasks for any other name.
 std::unique_ptr<Task> make_task(const std::string& name);
 std::vector<std::string> task_names();
 

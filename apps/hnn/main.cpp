@@ -15,7 +15,6 @@
 #include "tasks/reproduce.h"
 #include "tasks/run.h"
 #include "tasks/task.h"
-#include "tasks/trainer.h"
 
 namespace hnn::app {
 
@@ -88,27 +87,29 @@ tasks::RunOptions resumed_options(const CLI::App& cmd, const std::string& dir, b
 void add_train_command(CLI::App& app) {
   auto* cmd = app.add_subcommand("train", "Train and evaluate one model on a task");
   auto options = std::make_shared<tasks::RunOptions>();
+  auto model = std::make_shared<std::string>("hnn"), dtype = std::make_shared<std::string>("double");
+  auto preset = std::make_shared<std::string>("paper");
   auto steps = std::make_shared<int>(0), batch = std::make_shared<int>(-1);
   auto lr = std::make_shared<double>(0);
   auto hidden = std::make_shared<std::vector<int>>();
   auto resume = std::make_shared<std::string>();
   auto checkpoint_every = std::make_shared<long>(0);
   cmd->add_option("task", options->task, "Task: " + task_list() + " (required unless --resume)");
-  cmd->add_option("--model", options->model, "hnn or baseline")
-      ->check(CLI::IsMember({"hnn", "baseline"}))
+  cmd->add_option("--model", *model, "hnn or baseline")
+      ->check(CLI::IsMember(tasks::model_names()))
       ->capture_default_str();
   cmd->add_option("--steps", *steps, "Training steps (default: the paper's)")
       ->check(positive_integer());
   cmd->add_option("--seed", options->seed, "Seed of the data, initialisation and batches")
       ->check(seed_value())
       ->capture_default_str();
-  cmd->add_option("--dtype", options->dtype, "float or double")
-      ->check(CLI::IsMember({"float", "double"}))
+  cmd->add_option("--dtype", *dtype, "float or double")
+      ->check(CLI::IsMember(tasks::dtype_names()))
       ->capture_default_str();
   cmd->add_option("--threads", options->threads, "Threads for matrix products")
       ->check(integer_in(1, 256))
       ->capture_default_str();
-  cmd->add_option("--preset", options->preset,
+  cmd->add_option("--preset", *preset,
                   "Model widths: paper (the paper's 200-200) or lean (the smallest within the "
                   "noise of paper's accuracy); --hidden overrides either")
       ->check(CLI::IsMember(tasks::preset_names()))
@@ -133,12 +134,15 @@ void add_train_command(CLI::App& app) {
       return train_until_done_or_stopped(resumed_options(*cmd, *resume, options->quiet));
     tasks::RunOptions o = *options;
     if (o.task.empty()) throw std::invalid_argument("train needs a TASK (or --resume DIR)");
+    o.model = tasks::parse_model(*model);
+    o.dtype = tasks::parse_dtype(*dtype);
+    o.preset = tasks::parse_preset(*preset);
     if (*steps > 0) o.steps = *steps;
     if (*batch >= 0) o.batch_size = *batch;
     if (*lr > 0) o.learning_rate = *lr;
     if (!hidden->empty()) o.hidden = *hidden;
     if (*checkpoint_every > 0) o.checkpoint_every = *checkpoint_every;
-    if (o.out.empty()) o.out = std::filesystem::path("runs") / o.task / o.model;
+    if (o.out.empty()) o.out = std::filesystem::path("runs") / o.task / *model;
     tasks::check_no_unfinished_run(o.out);
     train_until_done_or_stopped(o);
   });
@@ -164,16 +168,17 @@ void add_evaluate_command(CLI::App& app) {
 void add_reproduce_command(CLI::App& app) {
   auto* cmd = app.add_subcommand("reproduce", "Train baseline and HNN on every task: Table 1");
   auto options = std::make_shared<tasks::ReproduceOptions>();
+  auto dtype = std::make_shared<std::string>("double"), preset = std::make_shared<std::string>("paper");
   auto steps = std::make_shared<int>(0);
   cmd->add_option("--tasks", options->tasks, "Comma-separated tasks (default: all)")
       ->delimiter(',');
   cmd->add_option("--seeds", options->seeds, "Seeds per task and model (averaged)")
       ->check(positive_integer())
       ->capture_default_str();
-  cmd->add_option("--dtype", options->dtype, "float or double")
-      ->check(CLI::IsMember({"float", "double"}))
+  cmd->add_option("--dtype", *dtype, "float or double")
+      ->check(CLI::IsMember(tasks::dtype_names()))
       ->capture_default_str();
-  cmd->add_option("--preset", options->preset, "Model widths of every run: paper or lean")
+  cmd->add_option("--preset", *preset, "Model widths of every run: paper or lean")
       ->check(CLI::IsMember(tasks::preset_names()))
       ->capture_default_str();
   cmd->add_option("--jobs", options->jobs, "Runs trained at once")
@@ -186,6 +191,8 @@ void add_reproduce_command(CLI::App& app) {
                 "Skip the reversibility report (the table only, sooner)");
   cmd->callback([=] {
     tasks::ReproduceOptions o = *options;
+    o.dtype = tasks::parse_dtype(*dtype);
+    o.preset = tasks::parse_preset(*preset);
     if (*steps > 0) o.steps = *steps;
     tasks::reproduce(o);
     fmt::print("hnn reproduce: {}\n", (o.out / "table1.md").string());

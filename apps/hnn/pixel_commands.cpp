@@ -6,8 +6,10 @@
 
 #include "apps/hnn/commands.h"
 #include "apps/hnn/validators.h"
+#include "tasks/pixel/bump.h"
 #include "tasks/pixel_pendulum.h"
-#include "tasks/reversibility.h"
+#include "tasks/reproduce.h"
+#include "tasks/run.h"
 
 namespace hnn::app {
 
@@ -48,8 +50,11 @@ void add_bump_command(CLI::App& app) {
   cmd->callback([=] {
     single_threaded();
     tasks::pixel::BumpOptions options = *o;
-    options.out = *out;
-    const tasks::pixel::BumpResult r = tasks::pixel::energy_bump(*dir, options);
+    options.out = out->empty() ? std::filesystem::path(*dir) : std::filesystem::path(*out);
+    const tasks::LoadedRun run = tasks::load_run(*dir);
+    const tasks::pixel::PixelParts parts = tasks::pixel_parts(*run.run);
+    const tasks::pixel::BumpResult r =
+        tasks::pixel::energy_bump(parts.model, parts.data, parts.config, options);
     fmt::print(
         "hnn bump: test trial {}, {:.3g} time units along R_H: learned H {:.4g} -> {:.4g}; "
         "energy from frames {:.4g} -> {:.4g}; amplitude {:.3f} -> {:.3f} rad\n",
@@ -85,7 +90,9 @@ void add_animate_command(CLI::App& app) {
     const std::filesystem::path dir =
         out->empty() ? std::filesystem::path(*hnn).lexically_normal().parent_path()
                      : std::filesystem::path(*out);
-    tasks::pixel::write_comparison(*baseline, *hnn, dir, *trajectories, *stride);
+    const tasks::LoadedRun base_run = tasks::load_run(*baseline), hnn_run = tasks::load_run(*hnn);
+    tasks::pixel::write_comparison(tasks::pixel_parts(*base_run.run),
+                                   tasks::pixel_parts(*hnn_run.run), dir, *trajectories, *stride);
     fmt::print("hnn animate: {} and {}\n", (dir / "rollout.gif").string(),
                (dir / "rollout_strip.png").string());
   });

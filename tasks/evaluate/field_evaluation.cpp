@@ -1,0 +1,95 @@
+#include "tasks/evaluate/field_evaluation.h"
+
+#include <fmt/format.h>
+
+#include <chrono>
+#include <cmath>
+
+#include "nn/hnn.h"
+#include "tasks/report/json_values.h"
+
+namespace hnn::tasks {
+
+using nlohmann::json;
+
+FieldEvaluation evaluate_field_model(const physics::System& truth,
+                                     const nn::DynamicsModel<double>& model, const Dataset& data,
+                                     const Batch& x0, const RolloutConfig& config) {
+  const auto start = std::chrono::steady_clock::now();
+  const nn::MeanStderr train = loss_stats(model, data.train_x, data.train_dxdt);
+  const nn::MeanStderr test = loss_stats(model, data.test_x, data.test_dxdt);
+  FieldEvaluation e{.rollouts = make_rollouts(truth, model, x0, config)};
+  const nn::MeanStderr energy = energy_mse(e.rollouts);
+  e.metrics = {{"train_loss", number(train.mean)},  {"train_loss_se", number(train.std_error)},
+               {"test_loss", number(test.mean)},    {"test_loss_se", number(test.std_error)},
+               {"energy_mse", number(energy.mean)}, {"energy_mse_se", number(energy.std_error)},
+               {"n_rollouts", energy.count},        {"rollout_failures", e.rollouts.failures},
+               {"n_train", data.train_x.rows()},    {"n_test", data.test_x.rows()}};
+  e.metrics["eval_seconds"] =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return e;
+}
+
+namespace {
+
+std::string cell(double v) { return std::isfinite(v) ? fmt::format("{:.12g}", v) : ""; }
+
+std::string rollout_row(const Rollouts& r, std::size_t i, std::size_t k) {
+  const Eigen::Index row = Eigen::Index(k), traj = Eigen::Index(i);
+  std::string line = fmt::format("{},{:.9g}", i, r.t[k]);
+  for (Eigen::Index c = 0; c < r.truth[i].cols(); ++c) line += "," + cell(r.truth[i](row, c));
+  for (Eigen::Index c = 0; c < r.pred[i].cols(); ++c) line += "," + cell(r.pred[i](row, c));
+  line += "," + cell(r.true_energy(traj, row)) + "," + cell(r.pred_energy(traj, row)) + ",";
+  if (r.learned_h.size() > 0) line += cell(r.learned_h(traj, row));
+  return line + "\n";
+}
+
+}  // namespace
+
+std::string rollout_csv(const Rollouts& r) {
+  const Eigen::Index dim = r.truth.empty() ? 0 : r.truth[0].cols();
+  std::string csv = "traj,t";
+  for (const char* which : {"true", "pred"})
+    for (Eigen::Index k = 0; k < dim; ++k) csv += fmt::format(",{}_{}", which, k);
+  csv += ",true_energy,pred_energy,learned_h\n";
+  for (std::size_t i = 0; i < r.truth.size(); ++i)
+    for (std::size_t k = 0; k < r.t.size(); ++k) csv += rollout_row(r, i, k);
+  return csv;
+}
+
+namespace {
+
+// One CSV block per source: source,traj,t,x_0..x_{d-1},energy,learned_h
+void append_paths(std::string& csv, std::string_view source, const physics::Trajectory& path,
+                  const physics::System& truth, const nn::Hnn<double>* hnn) {
+  for (Eigen::Index row = 0; row < path.states.front().rows(); ++row) {
+    const Eigen::MatrixXd states = path.path(row);
+    const Eigen::VectorXd energy = truth.energy_batch(physics::Batch(states));
+    Eigen::VectorXd h;
+    if (hnn) h = hnn->energy(physics::Batch(states)).col(0);
+    for (Eigen::Index k = 0; k < states.rows(); ++k) {
+      csv += fmt::format("{},{},{:.9g}", source, row, path.t[std::size_t(k)]);
+      for (Eigen::Index c = 0; c < states.cols(); ++c) csv += fmt::format(",{:.12g}", states(k, c));
+      csv += fmt::format(",{:.12g},{}\n", energy(k), hnn ? fmt::format("{:.12g}", h(k)) : "");
+    }
+  }
+}
+
+}  // namespace
+
+std::string rollout_paths_csv(const physics::System& truth, const nn::DynamicsModel<double>& model,
+                              std::string_view model_name, const Batch& x0,
+                              const physics::Integrator& integrator, const std::vector<double>& t) {
+  const physics::VectorField learned = [&model](double, const Batch& x, Batch& dxdt) {
+    dxdt = model.field(x);
+  };
+  std::string csv = "source,traj,t";
+  for (Eigen::Index c = 0; c < x0.cols(); ++c) csv += fmt::format(",x_{}", c);
+  csv += ",energy,learned_h\n";
+  append_paths(csv, "true", integrator.integrate(truth.field(), x0, t), truth, nullptr);
+  append_paths(csv, model_name, integrator.integrate(learned, x0, t), truth,
+               dynamic_cast<const nn::Hnn<double>*>(&model));
+  return csv;
+}
+
+}  // namespace hnn::tasks

@@ -1,0 +1,34 @@
+#pragma once
+// The evaluation of the tasks that learn a field: losses over both splits with standard errors,
+// and the energy MSE of rollouts against the true system, as the metrics of metrics.json.
+
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "nn/dynamics.h"
+#include "physics/integrator.h"
+#include "tasks/data/dataset.h"
+#include "tasks/evaluate/rollouts.h"
+
+namespace hnn::tasks {
+
+struct FieldEvaluation {
+  nlohmann::json metrics;  // train/test loss and energy MSE with standard errors, counts, time
+  Rollouts rollouts;
+};
+
+/// Evaluates `model` on `data` and on rollouts from `x0` against `truth`.
+FieldEvaluation evaluate_field_model(const physics::System& truth,
+                                     const nn::DynamicsModel<double>& model, const Dataset& data,
+                                     const Batch& x0, const RolloutConfig& config);
+
+/// rollout.csv: traj,t,true_0..,pred_0..,true_energy,pred_energy,learned_h.
+std::string rollout_csv(const Rollouts& rollouts);
+
+/// `hnn rollout`'s CSV: the true and the learned paths from each row of x0 with `integrator` at
+/// times t, as source,traj,t,x_0..x_{d-1},energy,learned_h (source "true" or `model_name`).
+std::string rollout_paths_csv(const physics::System& truth, const nn::DynamicsModel<double>& model,
+                              std::string_view model_name, const Batch& x0,
+                              const physics::Integrator& integrator, const std::vector<double>& t);
+
+}  // namespace hnn::tasks

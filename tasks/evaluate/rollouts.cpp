@@ -1,0 +1,123 @@
+#include "tasks/evaluate/rollouts.h"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <stdexcept>
+
+#include "nn/hnn.h"
+#include "physics/integrator.h"
+#include "physics/types.h"
+
+namespace hnn::tasks {
+
+namespace {
+
+constexpr Eigen::Index kChunk = 4096;
+constexpr int kSplits = 5;
+// A learned rollout taking more steps than this is reported as failed (with the time reached)
+// rather than left to run for hours: a badly trained field can be stiff enough to need the
+// integrator's default limit of 1e8 steps. True fields keep that default.
+constexpr long kMaxLearnedSteps = 100'000;
+
+Eigen::MatrixXd integrate_one(const physics::VectorField& field, const Eigen::RowVectorXd& x0,
+                              const std::vector<double>& t, const RolloutConfig& config, long* nfev,
+                              long max_steps = physics::IntegratorOptions{}.max_steps) {
+  const auto dopri = physics::make_integrator(
+      "dopri5", {.rtol = config.rtol, .atol = config.atol, .max_steps = max_steps});
+  const physics::Trajectory path = dopri->integrate(field, Batch(x0), t);
+  if (nfev) *nfev += path.stats.nfev;
+  return path.path(0);
+}
+
+}  // namespace
+
+nn::MeanStderr loss_stats(const nn::DynamicsModel<double>& model, const Batch& x,
+                          const Batch& dxdt) {
+  if (x.rows() == 0) throw std::invalid_argument("loss_stats: no points");
+  Batch errors(x.rows(), x.cols());  // squared error of every component of every point
+  for (Eigen::Index start = 0; start < x.rows(); start += kChunk) {
+    const Eigen::Index n = std::min(kChunk, x.rows() - start);
+    const Batch pred = model.field(x.middleRows(start, n));
+    errors.middleRows(start, n) = (pred - dxdt.middleRows(start, n)).array().square().matrix();
+  }
+  // The reference's error bar: torch's std (n - 1) over all N x D squared errors, / sqrt(N).
+  const double mean = errors.mean(), count = double(errors.size());
+  const double variance = count > 1 ? (errors.array() - mean).square().sum() / (count - 1) : 0.0;
+  return {mean, std::sqrt(variance / double(x.rows())), std::size_t(x.rows())};
+}
+
+Rollouts make_rollouts(const physics::System& truth, const nn::DynamicsModel<double>& model,
+                       const Batch& x0, const RolloutConfig& config) {
+  const auto* hnn = dynamic_cast<const nn::Hnn<double>*>(&model);
+  const bool has_h = hnn != nullptr && model.config().field != nn::FieldType::kConservative;
+  const physics::VectorField learned = [&model](double, const Batch& x, Batch& dxdt) {
+    dxdt = model.field(x);
+  };
+  Rollouts r;
+  r.t = physics::linspace(0.0, config.t_end, config.points);
+  const Eigen::Index n = x0.rows(), m = Eigen::Index(r.t.size());
+  r.true_energy.setConstant(n, m, NAN);
+  r.pred_energy.setConstant(n, m, NAN);
+  if (has_h) r.learned_h.setConstant(n, m, NAN);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const Eigen::MatrixXd path = integrate_one(truth.field(), x0.row(i), r.t, config, nullptr);
+    r.truth.push_back(path);
+    r.true_energy.row(i) = truth.energy_batch(Batch(path)).transpose();
+    try {
+      r.pred.push_back(integrate_one(learned, x0.row(i), r.t, config, &r.nfev, kMaxLearnedSteps));
+      r.failed.push_back(false);
+      r.pred_energy.row(i) = truth.energy_batch(Batch(r.pred.back())).transpose();
+      if (has_h) r.learned_h.row(i) = hnn->energy(Batch(r.pred.back())).col(0).transpose();
+    } catch (const physics::IntegrationError& e) {
+      r.pred.push_back(Eigen::MatrixXd::Constant(m, x0.cols(), NAN));
+      r.failed.push_back(true);
+      r.failures.push_back(fmt::format("trajectory {}: {}", i, e.what()));
+    }
+  }
+  return r;
+}
+
+nn::MeanStderr energy_mse(const Rollouts& r) {
+  std::vector<double> per_trajectory;
+  for (std::size_t i = 0; i < r.failed.size(); ++i) {
+    if (r.failed[i]) continue;
+    const Eigen::Index row = Eigen::Index(i);
+    per_trajectory.push_back((r.true_energy.row(row) - r.pred_energy.row(row)).squaredNorm() /
+                             double(r.true_energy.cols()));
+  }
+  nn::MeanStderr out;
+  out.count = per_trajectory.size();
+  if (per_trajectory.empty()) {
+    out.mean = out.std_error = NAN;
+    return out;
+  }
+  double sum = 0;
+  for (double v : per_trajectory) sum += v;
+  out.mean = sum / double(per_trajectory.size());
+  // Standard error from the spread of the means of 5 interleaved splits.
+  const int splits = std::min<int>(kSplits, int(per_trajectory.size()));
+  Eigen::VectorXd means = Eigen::VectorXd::Zero(splits), counts = Eigen::VectorXd::Zero(splits);
+  for (std::size_t i = 0; i < per_trajectory.size(); ++i) {
+    means(int(i % splits)) += per_trajectory[i];
+    counts(int(i % splits)) += 1;
+  }
+  means = means.cwiseQuotient(counts);
+  const double spread = std::sqrt((means.array() - means.mean()).square().mean());
+  out.std_error = splits > 1 ? spread / std::sqrt(double(splits)) : NAN;
+  return out;
+}
+
+Eigen::VectorXd coordinate_mse_over_time(const Rollouts& r) {
+  const Eigen::Index m = Eigen::Index(r.t.size());
+  Eigen::VectorXd mse = Eigen::VectorXd::Zero(m);
+  int used = 0;
+  for (std::size_t i = 0; i < r.truth.size(); ++i) {
+    if (r.failed[i]) continue;
+    mse += (r.truth[i] - r.pred[i]).array().square().rowwise().mean().matrix();
+    ++used;
+  }
+  return used > 0 ? Eigen::VectorXd(mse / used) : Eigen::VectorXd::Constant(m, NAN);
+}
+
+}  // namespace hnn::tasks

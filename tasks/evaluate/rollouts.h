@@ -1,0 +1,56 @@
+#pragma once
+// The shared evaluator: final losses with standard errors, and rollouts of the true and learned
+// fields from the same initial states for the energy metric and the charts.
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "nn/dynamics.h"
+#include "nn/loss.h"
+#include "physics/system.h"
+
+namespace hnn::tasks {
+
+using physics::Batch;
+
+/// How rollouts for the energy metric are made.
+struct RolloutConfig {
+  int trajectories = 15;
+  double t_end = 20.0;
+  int points = 100;
+  double rtol = 1e-9;
+  double atol = 1e-12;
+};
+
+/// Mean squared error of the model's field over a whole split (all N points, all D components),
+/// with the reference implementation's standard error: std(N x D squared errors, n - 1
+/// normalised) / sqrt(N), the convention of the paper's Table 1. Throws on an empty split.
+nn::MeanStderr loss_stats(const nn::DynamicsModel<double>& model, const Batch& x,
+                          const Batch& dxdt);
+
+/// Rollouts from n initial states at the same times. Row i of each matrix is trajectory i.
+struct Rollouts {
+  std::vector<double> t;
+  std::vector<Eigen::MatrixXd> truth, pred;  // per trajectory: times x dim
+  Eigen::MatrixXd true_energy, pred_energy;  // trajectories x times
+  Eigen::MatrixXd learned_h;                 // the HNN's own H along its rollout (empty if none)
+  std::vector<bool> failed;                  // the learned rollout blew up (excluded from MSEs)
+  std::vector<std::string> failures;         // why, with the time reached
+  long nfev = 0;                             // learned-field evaluations, all trajectories
+};
+
+/// Integrates the true field and the model's field from each row of x0 with the adaptive
+/// Dormand-Prince 5(4) method at config.rtol. A learned rollout that blows up is recorded as
+/// failed (with the time reached), never padded or silently dropped.
+Rollouts make_rollouts(const physics::System& truth, const nn::DynamicsModel<double>& model,
+                       const Batch& x0, const RolloutConfig& config);
+
+/// Energy MSE: mean over trajectories and times of (E(true) - E(model))^2, with a standard error
+/// from 5 interleaved splits of the trajectories (the reference's "bootstrap" of 5 splits).
+nn::MeanStderr energy_mse(const Rollouts& rollouts);
+
+/// Mean over trajectories of the coordinate MSE at each time (for the charts).
+Eigen::VectorXd coordinate_mse_over_time(const Rollouts& rollouts);
+
+}  // namespace hnn::tasks

@@ -1,0 +1,136 @@
+// The run of a field task: train a dynamics model on the task's dataset with FieldObjective,
+// evaluate it against the true system, save and load it, roll it out.
+
+#include "tasks/field_task.h"
+
+#include <variant>
+
+#include "nn/checkpoint.h"
+#include "nn/hnn.h"
+#include "physics/integrator.h"
+#include "tasks/evaluate/field_evaluation.h"
+#include "tasks/train/field_objective.h"
+
+namespace hnn::tasks {
+
+namespace {
+
+class FieldRun : public TaskRun {
+ public:
+  FieldRun(const FieldTask& task, RunSettings settings)
+      : task_(task), s_(std::move(settings)), data_(task.build_dataset(s_)) {
+    // Checked before a run folder exists: a bad batch size leaves nothing behind.
+    HNN_TASKS_CHECK(s_.train.batch_size <= data_.train_x.rows(),
+                    "--batch {} is larger than the training set ({} rows)", s_.train.batch_size,
+                    data_.train_x.rows());
+  }
+
+  TrainResult train(const LoopOptions& loop) override {
+    return with_scalar(s_.dtype, [&]<typename T>() {
+      std::unique_ptr<nn::DynamicsModel<T>> model = fresh_model<T>();
+      FieldObjective<T> objective(
+          *model, data_, s_.train.batch_size,
+          {.lr = s_.train.learning_rate, .weight_decay = s_.train.weight_decay}, s_.seed);
+      const TrainResult result = tasks::train(objective, loop);
+      keep(std::move(model));
+      return result;
+    });
+  }
+
+  void save(const std::filesystem::path& params) const override {
+    std::visit([&](const auto& model) { nn::save_parameters(params, *checked(model)); }, trained_);
+  }
+
+  void load(const std::filesystem::path& params) override {
+    with_scalar(s_.dtype, [&]<typename T>() {
+      std::unique_ptr<nn::DynamicsModel<T>> model = fresh_model<T>();
+      nn::load_parameters(params, *model);
+      keep(std::move(model));
+    });
+  }
+
+  nlohmann::json evaluate(const RunFolder* folder) const override {
+    const RolloutConfig config = task_.rollout_config();
+    const FieldEvaluation e = evaluate_field_model(task_.truth(), dynamics(), data_,
+                                                   rollout_states(config.trajectories), config);
+    if (folder) folder->write_text("rollout.csv", tasks::rollout_csv(e.rollouts));
+    return e.metrics;
+  }
+
+  std::string rollout_csv(const RolloutRequest& r) const override {
+    const auto integrator =
+        physics::make_integrator(r.integrator, {.dt = r.dt, .rtol = r.rtol, .atol = r.rtol * 1e-3});
+    return rollout_paths_csv(task_.truth(), dynamics(), nn::to_string(s_.model),
+                             rollout_states(r.trajectories), *integrator,
+                             physics::linspace(0.0, r.t_end.value_or(rollout_span()), r.points));
+  }
+
+  const nn::DynamicsModel<double>& dynamics() const override { return *checked(model_); }
+
+  // The evaluation's states: a generator independent of the training data's draws.
+  physics::Batch rollout_states(int count) const override {
+    std::mt19937_64 rng(s_.seed + 1);
+    physics::Batch x0 = task_.rollout_states(data_, rng);
+    x0.conservativeResize(std::min<Eigen::Index>(x0.rows(), count), Eigen::NoChange);
+    return x0;
+  }
+
+  double rollout_span() const override { return task_.rollout_config().t_end; }
+
+ private:
+  template <typename T>
+  std::unique_ptr<nn::DynamicsModel<T>> fresh_model() const {
+    nn::DynamicsConfig config{.model = s_.model, .dim = data_.train_x.cols()};
+    config.hidden.assign(s_.train.hidden.begin(), s_.train.hidden.end());
+    try {
+      nn::validate(config);
+    } catch (const std::invalid_argument& e) {
+      throw Error(fmt::format("task '{}': {}", s_.task, e.what()));
+    }
+    std::mt19937_64 rng(s_.seed);
+    return nn::make_model<T>(config, rng);
+  }
+
+  // The trained model in its own type (what save writes) and in double (what evaluation uses:
+  // the rollout integrator's tolerance is then not limited by float rounding of the field).
+  template <typename T>
+  void keep(std::unique_ptr<nn::DynamicsModel<T>> model) {
+    model_ = nn::cast_model<double>(*model);
+    trained_ = std::move(model);
+  }
+
+  template <typename P>
+  static const P& checked(const P& model) {
+    HNN_TASKS_CHECK(model != nullptr, "the run has no model yet: train or load it first");
+    return model;
+  }
+
+  const FieldTask& task_;
+  RunSettings s_;
+  Dataset data_;
+  std::variant<std::unique_ptr<nn::DynamicsModel<float>>,
+               std::unique_ptr<nn::DynamicsModel<double>>>
+      trained_;
+  std::unique_ptr<nn::DynamicsModel<double>> model_;
+};
+
+}  // namespace
+
+std::unique_ptr<TaskRun> FieldTask::open(const RunSettings& settings) const {
+  return std::make_unique<FieldRun>(*this, settings);
+}
+
+std::unique_ptr<FieldTask> make_field_task(const std::string& name) {
+  std::unique_ptr<Task> task = make_task(name);
+  HNN_TASKS_CHECK(dynamic_cast<FieldTask*>(task.get()) != nullptr,
+                  "task '{}' does not learn a field from states", name);
+  return std::unique_ptr<FieldTask>(static_cast<FieldTask*>(task.release()));
+}
+
+Dataset build_dataset(const std::string& task, std::uint64_t seed) {
+  const std::unique_ptr<FieldTask> field_task = make_field_task(task);
+  RunSettings settings{.task = task, .seed = seed};
+  return field_task->build_dataset(settings);
+}
+
+}  // namespace hnn::tasks

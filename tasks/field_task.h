@@ -1,0 +1,38 @@
+#pragma once
+// The tasks that learn a field dx/dt = f(x) from states and their time derivatives (tasks 1-4b):
+// each gives its dataset, its true system and where the evaluation's rollouts start; the run
+// (training, evaluation, rollouts) is the same for all of them.
+
+#include <cstdint>
+#include <memory>
+#include <random>
+#include <string>
+
+#include "physics/system.h"
+#include "tasks/data/dataset.h"
+#include "tasks/evaluate/rollouts.h"
+#include "tasks/task.h"
+
+namespace hnn::tasks {
+
+class FieldTask : public Task {
+ public:
+  /// Deterministic: the same seed (and data file) give the same data, bit for bit.
+  virtual Dataset build_dataset(const RunSettings& settings) const = 0;
+  /// The ground truth for rollouts and energies (a fitted H for measured data).
+  virtual const physics::System& truth() const = 0;
+  /// Initial states of the energy-metric rollouts.
+  virtual Batch rollout_states(const Dataset& data, std::mt19937_64& rng) const = 0;
+  virtual RolloutConfig rollout_config() const { return {}; }
+
+  /// A FieldRun of this task; the task must outlive it.
+  std::unique_ptr<TaskRun> open(const RunSettings& settings) const override;
+};
+
+/// make_task(name) as a FieldTask; throws Error when the task learns something else.
+std::unique_ptr<FieldTask> make_field_task(const std::string& name);
+
+/// The dataset of a field task with its default settings and the given seed (tests, tools).
+Dataset build_dataset(const std::string& task, std::uint64_t seed);
+
+}  // namespace hnn::tasks

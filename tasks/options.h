@@ -1,0 +1,107 @@
+#pragma once
+// A run's options, typed and checked in one place: what a user asks for (RunOptions: a task, a
+// model and overrides of the task's defaults) and what a run is once resolved against its task
+// (RunSettings: every value set, as metrics.json and checkpoints record it).
+
+#include <cstdint>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "nn/dynamics.h"
+#include "tasks/train/loop.h"
+
+namespace hnn::tasks {
+
+class Task;
+
+/// The widest hidden layer a run may ask for (a typo like 20000 would need gigabytes).
+inline constexpr int kMaxWidth = 4096;
+
+/// How a model is trained. Every field can be overridden from the command line.
+struct TrainConfig {
+  int steps = 2000;
+  int batch_size = 0;  // 0: full batch
+  double learning_rate = 1e-3;
+  double weight_decay = 0.0;
+  std::vector<int> hidden = {200, 200};
+  int record_every = 0;  // loss-curve interval; 0 picks about 100 points
+};
+
+enum class Dtype { kFloat, kDouble };
+/// The training presets: the paper's widths, or each task's lean widths (Task::lean_hidden).
+enum class Preset { kPaper, kLean };
+
+std::string_view to_string(Dtype dtype);
+std::string_view to_string(Preset preset);
+/// Inverses of to_string; throw Error naming the valid values.
+Dtype parse_dtype(std::string_view name);
+Preset parse_preset(std::string_view name);
+std::vector<std::string> dtype_names();
+std::vector<std::string> preset_names();
+std::vector<std::string> model_names();
+/// nn::parse_model_kind, throwing Error.
+nn::ModelKind parse_model(std::string_view name);
+
+/// f.operator()<float>() or f.operator()<double>(): the one place a dtype picks a scalar type.
+template <typename F>
+decltype(auto) with_scalar(Dtype dtype, F&& f) {
+  if (dtype == Dtype::kFloat) return f.template operator()<float>();
+  return f.template operator()<double>();
+}
+
+struct RunSettings {
+  std::string task;
+  nn::ModelKind model = nn::ModelKind::kHnn;
+  std::uint64_t seed = 0;
+  Dtype dtype = Dtype::kDouble;
+  Preset preset = Preset::kPaper;
+  int threads = 2;  // the engine's threads: fused kernels split each batch into row blocks
+  TrainConfig train;
+  std::string data_file;  // measured-data tasks: another file of the same format
+  nlohmann::json task_settings = nlohmann::json::object();  // the task's own (Task::open)
+
+  /// The form metrics.json and checkpoints hold ("hidden": "200-200").
+  nlohmann::json to_json() const;
+};
+
+struct RunOptions {
+  std::string task;
+  nn::ModelKind model = nn::ModelKind::kHnn;
+  std::uint64_t seed = 0;
+  Dtype dtype = Dtype::kDouble;
+  Preset preset = Preset::kPaper;
+  int threads = 2;
+  std::optional<int> steps, batch_size;
+  std::optional<std::vector<int>> hidden;  // overrides the preset's widths
+  std::optional<double> learning_rate, weight_decay;
+  std::string data_file;
+  nlohmann::json task_settings = nlohmann::json::object();
+  std::filesystem::path out;
+  bool quiet = false;
+  /// Checkpoints into out/checkpoint every this many steps (default: a tenth of the steps), at
+  /// the end, and when stopped.
+  std::optional<long> checkpoint_every;
+  /// Continue the run in `out` from its last checkpoint (see resume_options).
+  bool resume = false;
+  /// Polled by the training loop (e.g. set on SIGINT): checkpoint and stop after the step.
+  StopSignal* stop = nullptr;
+};
+
+/// The task's defaults under the preset, with the options' overrides; throws Error naming the
+/// first bad value (including an option the task does not honour).
+RunSettings resolve(const Task& task, const RunOptions& options);
+/// resolve() against make_task(options.task), and the options that resolve does not see.
+RunSettings validate(const RunOptions& options);
+
+/// The options that rebuild a run from RunSettings::to_json (metrics.json or a checkpoint's
+/// settings): every setting as an override. Throws Error naming `where` and the bad key.
+RunOptions options_from_json(const nlohmann::json& settings, const std::string& where);
+
+/// "200-200".
+std::string join_widths(const std::vector<int>& widths);
+
+}  // namespace hnn::tasks

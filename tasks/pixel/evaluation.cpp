@@ -1,0 +1,167 @@
+// The pixel pendulum's evaluation: losses by term, latent rollouts decoded and compared with the
+// true Gym continuation, their files and figures; and the rollouts of `hnn rollout`.
+
+#include "tasks/pixel/evaluation.h"
+
+#include <fmt/format.h>
+
+#include <chrono>
+#include <cmath>
+
+#include "physics/integrator.h"
+#include "tasks/pixel/figures.h"
+#include "tasks/pixel/rollouts.h"
+#include "tasks/report/json_values.h"
+
+namespace hnn::tasks::pixel {
+
+using nlohmann::json;
+
+namespace {
+
+json stats_json(const nn::MeanStderr& s) {
+  return {{"mean", number(s.mean)}, {"se", number(s.std_error)}};
+}
+
+std::string cell(double v) { return std::isfinite(v) ? fmt::format("{:.9g}", v) : ""; }
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+std::string rollout_csv(const PixelRollouts& r) {
+  std::string csv =
+      "traj,frame,frame_mse,true_theta,true_p,true_energy,pred_theta,pred_p,pred_energy,"
+      "frames_energy,z_q,z_p,learned_h,pair_energy\n";
+  for (Eigen::Index i = 0; i < r.true_energy.rows(); ++i) {
+    for (Eigen::Index k = 0; k < Eigen::Index(r.t.size()); ++k) {
+      csv +=
+          fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", i, r.t[std::size_t(k)],
+                      cell(r.frame_mse(i, k)), cell(r.true_theta(i, k)), cell(r.true_p(i, k)),
+                      cell(r.true_energy(i, k)), cell(r.pred_theta(i, k)), cell(r.pred_p(i, k)),
+                      cell(r.pred_energy(i, k)), cell(r.frames_energy(i, k)),
+                      cell(r.z[std::size_t(i)](k, 0)), cell(r.z[std::size_t(i)](k, 1)),
+                      r.learned_h.size() ? cell(r.learned_h(i, k)) : "", cell(r.pair_energy(i, k)));
+    }
+  }
+  return csv;
+}
+
+// Mean over trajectories of (max |theta| over the last 40 frames) / (max |theta| over the
+// first 40): about 1 when the swing keeps its amplitude.
+double amplitude_ratio(const Eigen::MatrixXd& theta) {
+  const Eigen::Index m = theta.cols(), w = std::min<Eigen::Index>(40, m);
+  double sum = 0;
+  int used = 0;
+  for (Eigen::Index i = 0; i < theta.rows(); ++i) {
+    const double first = theta.row(i).head(w).cwiseAbs().maxCoeff();
+    const double last = theta.row(i).tail(w).cwiseAbs().maxCoeff();
+    if (std::isfinite(first) && std::isfinite(last) && first > 0) {
+      sum += last / first;
+      ++used;
+    }
+  }
+  return used ? sum / used : NAN;
+}
+
+}  // namespace
+
+json evaluate_pixel_model(const PixelModel<double>& model, const PixelData& data,
+                          const PixelConfig& config, const RunFolder* folder) {
+  const auto start = std::chrono::steady_clock::now();
+  const PixelLossStats train = pixel_loss_stats(model, data, false, config.hnn_weight);
+  const PixelLossStats test = pixel_loss_stats(model, data, true, config.hnn_weight);
+  const PixelRollouts r = pixel_rollouts(model, data, config, 2);
+  const nn::MeanStderr energy = pixel_energy_mse(r);
+  const nn::MeanStderr floor = pixel_energy_mse(r, EnergySource::kTrueFrames);
+  const nn::MeanStderr within_pair = pixel_energy_mse(r, EnergySource::kWithinPair);
+  Eigen::VectorXd frame_mse = Eigen::VectorXd::Zero(Eigen::Index(r.t.size()));
+  int used = 0;
+  for (Eigen::Index i = 0; i < r.frame_mse.rows(); ++i) {
+    if (r.failed[std::size_t(i)]) continue;
+    frame_mse += r.frame_mse.row(i).transpose();
+    ++used;
+  }
+  frame_mse /= std::max(used, 1);
+  const auto terms = [](const PixelLossStats& s) {
+    return json{{"ae", stats_json(s.ae)}, {"cc", stats_json(s.cc)}, {"hnn", stats_json(s.hnn)}};
+  };
+  json m = {{"train_loss", number(train.total.mean)},
+            {"train_loss_se", number(train.total.std_error)},
+            {"test_loss", number(test.total.mean)},
+            {"test_loss_se", number(test.total.std_error)},
+            {"energy_mse", number(energy.mean)},
+            {"energy_mse_se", number(energy.std_error)},
+            {"n_rollouts", energy.count},
+            {"rollout_failures", r.failures},
+            {"n_train", data.train_rows()},
+            {"n_test", data.test_rows},
+            {"loss_terms", {{"train", terms(train)}, {"test", terms(test)}}},
+            {"energy_mse_frames_floor", number(floor.mean)},
+            {"energy_mse_within_pair", number(within_pair.mean)},
+            {"energy_mse_within_pair_se", number(within_pair.std_error)},
+            {"frame_mse_mean", number(frame_mse.mean())},
+            {"frame_mse_first", number(frame_mse(0))},
+            {"frame_mse_last", number(frame_mse(frame_mse.size() - 1))},
+            {"amplitude_ratio", number(amplitude_ratio(r.pred_theta))},
+            {"amplitude_ratio_true", number(amplitude_ratio(r.true_theta))},
+            {"rollout_frames", config.rollout_frames},
+            {"rollout_nfev", r.nfev}};
+  if (folder) {
+    folder->write_text("pixel_rollout.csv", rollout_csv(r));
+    write_latent_files(model, data, *folder);
+    if (!r.true_frames.empty()) {
+      std::vector<std::vector<const Eigen::MatrixXf*>> grid;
+      for (std::size_t i = 0; i < r.true_frames.size(); ++i)
+        grid.push_back({&r.true_frames[i], &r.pred_frames[i]});
+      write_animation(folder->file("rollout.gif"), grid);
+      write_strip(folder->file("rollout_strip.png"), {&r.true_frames[0], &r.pred_frames[0]}, 10);
+    }
+  }
+  m["eval_seconds"] = seconds_since(start);
+  return m;
+}
+
+std::string pixel_rollout_csv(const PixelModel<double>& model, const PixelData& data,
+                              std::string_view model_name, const PixelRolloutOptions& o) {
+  const physics::GymPendulum scene;
+  const int n = std::min(o.trajectories, data.test_trials());
+  std::vector<Eigen::Index> rows;
+  for (int i = 0; i < n; ++i) rows.push_back(Eigen::Index(i) * data.pairs_per_trial());
+  const physics::Batch z0 = model.encode(data.pairs_of<double>(rows, false));
+  const auto integrator =
+      physics::make_integrator(o.integrator, {.dt = o.dt, .rtol = o.rtol, .atol = o.rtol * 1e-3});
+  // One frame past the last reported: its angle gives the last state's velocity.
+  const std::vector<double> t = physics::linspace(0.0, o.frames + 1, o.frames + 2);
+  const nn::DynamicsModel<double>& dynamics = model.dynamics();
+  const physics::Trajectory path = integrator->integrate(
+      [&dynamics](double, const physics::Batch& z, physics::Batch& dz) { dz = dynamics.field(z); },
+      z0, t);
+  std::string csv = "source,traj,t,z_q,z_p,theta,p,energy,learned_h\n";
+  for (int i = 0; i < n; ++i) {
+    const std::vector<physics::GymState> states = scene.rollout(
+        data.states[std::size_t(data.first_frame(rows[std::size_t(i)]))], o.frames + 2);
+    for (int k = 0; k <= o.frames; ++k) {
+      const Eigen::RowVector2d x =
+          pair_state(states[std::size_t(k)].th, states[std::size_t(k) + 1].th);
+      csv += fmt::format("true,{},{},,,{:.9g},{:.9g},{:.9g},\n", i, t[std::size_t(k)], x(0), x(1),
+                         scene.energy(x));
+    }
+    const physics::Batch z = path.path(i);
+    const physics::Batch pairs = model.decode(z);
+    Eigen::VectorXd h;
+    if (model.is_hnn()) h = model.energy(z).col(0);
+    // As pixel_rollouts (Note [Velocity from the rollout's frames]): the first frames of
+    // consecutive decoded pairs.
+    for (Eigen::Index k = 0; k + 1 < z.rows(); ++k) {
+      const Eigen::RowVector2d x = state_from_frames(scene, pairs.row(k).head(kFramePixels),
+                                                     pairs.row(k + 1).head(kFramePixels));
+      csv += fmt::format("{},{},{},{:.9g},{:.9g},{},{},{},{}\n", model_name, i,
+                         t[std::size_t(k)], z(k, 0), z(k, 1), cell(x(0)), cell(x(1)),
+                         cell(scene.energy(x)), h.size() ? cell(h(k)) : "");
+    }
+  }
+  return csv;
+}
+
+}  // namespace hnn::tasks::pixel

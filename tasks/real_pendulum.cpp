@@ -1,0 +1,89 @@
+// Task 3: the real pendulum of Schmidt & Lipson (2009), from measured angles and velocities.
+// It has friction, which an HNN cannot model: its test loss is expected to be worse than the
+// baseline's while its energy stays nearly constant.
+
+#include "physics/lipson.h"
+#include "physics/oscillators.h"
+#include "tasks/data/data_files.h"
+#include "tasks/data/trajectories.h"
+#include "tasks/experiments.h"
+#include "tasks/field_task.h"
+
+namespace hnn::tasks {
+
+namespace {
+
+class RealPendulumTask : public FieldTask {
+ public:
+  std::string name() const override { return "real-pendulum"; }
+  std::string summary() const override {
+    return "task 3: real pendulum, Schmidt & Lipson (2009) measured data, has friction";
+  }
+  TrainConfig train_config() const override {
+    return {.steps = 2000, .batch_size = 0, .weight_decay = 1e-5};
+  }
+  // The `lean` preset (docs/speed_accuracy.md, chart 4): within the noise of 200-200.
+  std::vector<int> lean_hidden() const override { return {16, 16}; }
+  Dataset build_dataset(const RunSettings& settings) const override {
+    const physics::LipsonData data = physics::load_lipson(
+        settings.data_file.empty() ? default_data_path(kDataFile) : settings.data_file);
+    Batch x, dxdt;
+    forward_differences(data, x, dxdt);
+    const Eigen::Index cut = x.rows() * 8 / 10;  // order kept: the test set is the run's end
+    Dataset d;
+    std::tie(d.train_x, d.test_x) = split_rows(x, cut);
+    std::tie(d.train_dxdt, d.test_dxdt) = split_rows(dxdt, cut);
+    return d;
+  }
+  // The reference's fit to this data: H = 2.4 (1 - cos q) + p^2.
+  const physics::System& truth() const override { return fit_; }
+  /// Measured test states, evenly spread over the test run.
+  Batch rollout_states(const Dataset& data, std::mt19937_64&) const override {
+    const int n = rollout_config().trajectories;
+    Batch states(n, 2);
+    for (int i = 0; i < n; ++i) states.row(i) = data.test_x.row(i * data.test_x.rows() / n);
+    return states;
+  }
+  PaperRow paper(nn::ModelKind model) const override {
+    return model == nn::ModelKind::kHnn ? PaperRow{{9.2376e-3, 5.0e-4}, {5.9584e-3, 6.2e-4}, {1.4477e-2, 4.7e-3}}
+                          : PaperRow{{2.7455e-3, 2.1e-4}, {2.1864e-3, 3.3e-4}, {3.8564e-1, 6.9e-2}};
+  }
+  bool reads_data_file() const override { return true; }
+
+ private:
+  static constexpr std::size_t kMinSamples = 10;
+
+  // x = (angle, angular velocity); dx/dt by forward differences within each trial, the last
+  // point of each trial dropped.
+  static void forward_differences(const physics::LipsonData& data, Batch& x, Batch& dxdt) {
+    HNN_TASKS_CHECK(data.columns.size() >= 2, "{}: expected angle and velocity columns, got {}",
+                    data.path, data.columns.size());
+    const Eigen::MatrixXd state = data.state().leftCols(2);
+    std::vector<Eigen::Index> rows;
+    for (Eigen::Index i = 0; i + 1 < data.rows(); ++i)
+      if (data.trial(i) == data.trial(i + 1)) rows.push_back(i);
+    HNN_TASKS_CHECK(rows.size() >= kMinSamples,
+                    "{}: {} samples (pairs of consecutive rows in one trial); at least {} are "
+                    "needed to train and test",
+                    data.path, rows.size(), kMinSamples);
+    x.resize(Eigen::Index(rows.size()), 2);
+    dxdt.resize(Eigen::Index(rows.size()), 2);
+    for (std::size_t k = 0; k < rows.size(); ++k) {
+      const Eigen::Index i = rows[k];
+      const double dt = data.t(i + 1) - data.t(i);
+      HNN_TASKS_CHECK(dt > 0, "{}:{}: time does not increase within trial {} (t = {} then {})",
+                      data.path, data.line(i + 1), data.trial(i), data.t(i), data.t(i + 1));
+      x.row(Eigen::Index(k)) = state.row(i);
+      dxdt.row(Eigen::Index(k)) = (state.row(i + 1) - state.row(i)) / dt;
+    }
+  }
+
+  static constexpr const char* kDataFile = "lipson/real_pend_h_1.txt";
+  physics::Pendulum fit_{2.4};
+};
+
+}  // namespace
+
+std::unique_ptr<Task> make_real_pendulum_task() { return std::make_unique<RealPendulumTask>(); }
+
+}  // namespace hnn::tasks

@@ -1,0 +1,234 @@
+#include "tasks/train/loop.h"
+
+#include <chrono>
+#include <cmath>
+
+#include "autodiff/grad.h"
+#include "autodiff/tape.h"
+#include "tasks/error.h"
+#include "tasks/train/checkpoint.h"
+#include "tasks/train/progress.h"
+
+namespace hnn::tasks {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+long record_interval(const LoopOptions& o) {
+  return o.record_every > 0 ? o.record_every : std::max(1L, o.steps / 100);
+}
+
+// An Adam per parameter group, each stepped with its slice of the gradients of all parameters.
+template <typename T>
+class GroupedAdam {
+ public:
+  explicit GroupedAdam(const std::vector<ParameterGroup<T>>& groups) {
+    adams_.reserve(groups.size());  // no reallocation: the Adams stay where they are built
+    for (const ParameterGroup<T>& group : groups) {
+      adams_.emplace_back(group.parameters, group.adam);
+      slices_.emplace_back().reserve(group.parameters.size());
+      all_.insert(all_.end(), group.parameters.begin(), group.parameters.end());
+    }
+  }
+  const std::vector<ad::Var<T>>& parameters() const { return all_; }
+  std::vector<nn::Adam<T>>& adams() { return adams_; }
+
+  void step(const std::vector<ad::Var<T>>& grads) {
+    auto first = grads.begin();
+    for (std::size_t i = 0; i < adams_.size(); ++i) {
+      const auto count = std::ptrdiff_t(adams_[i].parameters().size());
+      slices_[i].assign(first, first + count);  // within capacity: no allocation
+      adams_[i].step(slices_[i]);
+      first += count;
+    }
+  }
+
+ private:
+  std::vector<nn::Adam<T>> adams_;
+  std::vector<std::vector<ad::Var<T>>> slices_;
+  std::vector<ad::Var<T>> all_;
+};
+
+// The groups must cover the model's parameters in order: checkpoints name Adam's moments after
+// them.
+template <typename T>
+void check_groups(Objective<T>& objective, const std::vector<ad::Var<T>>& grouped) {
+  const std::vector<ad::Var<T>> params = objective.model().parameters();
+  bool same = params.size() == grouped.size();
+  for (std::size_t i = 0; same && i < params.size(); ++i)
+    same = &params[i].value() == &grouped[i].value();
+  HNN_TASKS_CHECK(same, "the objective's parameter groups do not list the model's parameters in "
+                        "order");
+}
+
+// The checkpoints of one run (LoopOptions::checkpoint_dir): when they are due, writing them and
+// restoring from one.
+template <typename T>
+class Checkpoints {
+ public:
+  Checkpoints(const LoopOptions& o, std::uint64_t data_hash)
+      : o_(o), every_(o.checkpoint_every > 0 ? o.checkpoint_every : std::max(1L, o.steps / 10)),
+        data_hash_(data_hash) {}
+
+  bool enabled() const { return !o_.checkpoint_dir.empty(); }
+  bool due(long step) const { return enabled() && (step % every_ == 0 || step == o_.steps); }
+
+  void save(long step, Objective<T>& objective, GroupedAdam<T>& adam, const TrainResult& so_far) {
+    // A checkpoint holds finite parameters only: "the last good checkpoint" stays good.
+    for (const ad::Var<T>& p : adam.parameters()) {
+      if (!p.value().allFinite()) {
+        throw TrainingDiverged(
+            fmt::format("training diverged at step {}: the parameters are not finite{}", step,
+                        where()),
+            step);
+      }
+    }
+    TrainState state{.step = step,
+                     .total_steps = o_.steps,
+                     .sampler_state = objective.sampler().state(),
+                     .data_hash = data_hash_,
+                     .curve = so_far.curve,
+                     .seconds = so_far.seconds,
+                     .run = o_.run_settings};
+    save_train_checkpoint<T>(o_.checkpoint_dir, objective.model(), adam.adams(), std::move(state));
+    last_saved_ = step;
+  }
+
+  /// Loads the checkpoint into the model, the optimisers and the sampler; returns its state.
+  TrainState restore(Objective<T>& objective, GroupedAdam<T>& adam) {
+    const std::string dir = o_.checkpoint_dir.string();
+    TrainState state = read_train_state(o_.checkpoint_dir);
+    HNN_TASKS_CHECK(state.total_steps == o_.steps,
+                    "the checkpoint in '{}' is of a run of {} steps, not {}", dir,
+                    state.total_steps, o_.steps);
+    HNN_TASKS_CHECK(state.data_hash == data_hash_,
+                    "the training data differ from those of the checkpoint in '{}'", dir);
+    load_train_checkpoint<T>(o_.checkpoint_dir, state, objective.model(), adam.adams());
+    objective.sampler().set_state(state.sampler_state);
+    last_saved_ = state.step;
+    return state;
+  }
+
+  std::string where() const {
+    return last_saved_ > 0 ? fmt::format("; the last good checkpoint (step {}) is kept in {}",
+                                         last_saved_, o_.checkpoint_dir.string())
+                           : "";
+  }
+
+ private:
+  const LoopOptions& o_;
+  long every_;
+  std::uint64_t data_hash_;
+  long last_saved_ = 0;
+};
+
+// Arms a StopSignal for the lifetime of a training loop.
+class ArmStop {
+ public:
+  explicit ArmStop(StopSignal* stop) : stop_(stop) {
+    if (stop_) stop_->armed = true;
+  }
+  ~ArmStop() {
+    if (stop_) stop_->armed = false;
+  }
+  ArmStop(const ArmStop&) = delete;
+  ArmStop& operator=(const ArmStop&) = delete;
+
+ private:
+  StopSignal* stop_;
+};
+
+// Training time: the wall time since the start, less what recording and checkpoints took, plus
+// the time before a resume.
+class TrainClock {
+ public:
+  explicit TrainClock(double earlier) : earlier_(earlier) {}
+  double seconds() const {
+    return earlier_ + (std::chrono::duration<double>(Clock::now() - start_) - paused_).count();
+  }
+  template <typename F>
+  void pause_for(F&& work) {
+    const auto start = Clock::now();
+    work();
+    paused_ += Clock::now() - start;
+  }
+
+ private:
+  double earlier_;
+  Clock::time_point start_ = Clock::now();
+  std::chrono::duration<double> paused_{0};
+};
+
+// One step: the batch's loss, its gradients and the optimisers' update. Returns the loss.
+template <typename T>
+double train_step(long step, Objective<T>& objective, GroupedAdam<T>& adam,
+                  std::vector<ad::Var<T>>& grads, const std::string& where) {
+  ad::TapeScope scope;  // everything this step records is recycled at the closing brace
+  objective.sampler().next();
+  const ad::Var<T> loss = objective.batch_loss();
+  const double value = double(loss.item());
+  if (!std::isfinite(value)) {
+    throw TrainingDiverged(
+        fmt::format("training diverged at step {}: the loss is {}{}", step, value, where), step);
+  }
+  ad::grad_into(loss, adam.parameters(), grads);
+  adam.step(grads);
+  return value;
+}
+
+}  // namespace
+
+template <typename T>
+TrainResult train(Objective<T>& objective, const LoopOptions& o) {
+  HNN_TASKS_CHECK(o.steps > 0, "steps must be positive, got {}", o.steps);
+  GroupedAdam<T> adam(objective.parameter_groups());
+  check_groups(objective, adam.parameters());
+  Checkpoints<T> checkpoints(o, objective.data_fingerprint());
+  TrainResult result;
+  long first = 1;
+  double earlier_seconds = 0;
+  if (o.resume) {
+    const TrainState state = checkpoints.restore(objective, adam);
+    first = state.step + 1;
+    result.curve = state.curve;
+    earlier_seconds = state.seconds;
+  }
+  Progress progress(o.label, o.steps, o.quiet);
+  TrainClock clock(earlier_seconds);
+  const long interval = record_interval(o);
+  const ArmStop arm(o.stop);
+  std::vector<ad::Var<T>> grads;  // reused: a step allocates nothing in steady state
+  double loss = 0;
+  for (long step = first; step <= o.steps; ++step) {
+    loss = train_step(step, objective, adam, grads, checkpoints.where());
+    if (step % interval == 0 || step == o.steps) {
+      clock.pause_for([&] {
+        result.curve.push_back(objective.curve_point(step, loss));
+        if (o.on_record) o.on_record(step);
+      });
+    }
+    const bool stop = o.stop && o.stop->requested && step < o.steps;
+    if (checkpoints.due(step) || (stop && checkpoints.enabled())) {
+      result.seconds = clock.seconds();
+      clock.pause_for([&] { checkpoints.save(step, objective, adam, result); });
+    }
+    progress.update(step, loss);
+    if (stop) {
+      progress.stop(step, loss);
+      throw TrainingInterrupted(
+          fmt::format("training stopped at step {} of {}{}", step, o.steps,
+                      checkpoints.enabled() ? "; checkpoint in " + o.checkpoint_dir.string() : ""),
+          step);
+    }
+  }
+  result.seconds = clock.seconds();
+  result.steps = o.steps;
+  progress.finish(loss);
+  return result;
+}
+
+template TrainResult train(Objective<float>&, const LoopOptions&);
+template TrainResult train(Objective<double>&, const LoopOptions&);
+
+}  // namespace hnn::tasks

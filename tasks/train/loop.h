@@ -1,0 +1,79 @@
+#pragma once
+// The one training loop of every task: Adam per parameter group on an Objective's batch loss,
+// the loss curve at intervals, checkpoints, resume from a checkpoint, and stop on request.
+
+#include <atomic>
+#include <filesystem>
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "tasks/report/run_folder.h"
+#include "tasks/train/objective.h"
+
+namespace hnn::tasks {
+
+struct TrainResult {
+  std::vector<CurvePoint> curve;
+  double seconds = 0;  // the training steps only (no data, no loss-curve points, no evaluation)
+  long steps = 0;
+};
+
+/// Training stopped because the loss became NaN or infinite.
+class TrainingDiverged : public std::runtime_error {
+ public:
+  TrainingDiverged(const std::string& message, long step)
+      : std::runtime_error(message), step_(step) {}
+  long step() const { return step_; }
+
+ private:
+  long step_;
+};
+
+/// Training stopped on request (StopSignal) after `step()`, with a checkpoint written.
+class TrainingInterrupted : public std::runtime_error {
+ public:
+  TrainingInterrupted(const std::string& message, long step)
+      : std::runtime_error(message), step_(step) {}
+  long step() const { return step_; }
+
+ private:
+  long step_;
+};
+
+/// Asks a training loop to stop after its current step. Set from a signal handler, so it holds
+/// lock-free atomics only. `armed` is true while a loop polls `requested`: a handler can fall
+/// back to the signal's default action when nothing would.
+struct StopSignal {
+  std::atomic<bool> armed{false};
+  std::atomic<bool> requested{false};
+};
+
+struct LoopOptions {
+  long steps = 0;
+  long record_every = 0;  // loss-curve interval; 0: about 100 points
+  bool quiet = false;     // no progress output
+  std::string label = "train";
+  std::function<void(long step)> on_record{};  // after each loss-curve point
+  /// Checkpoints (train/checkpoint.h) go to this folder every `checkpoint_every` steps (0: a
+  /// tenth of the steps), at the last step, and when stopped; none when it is empty.
+  std::filesystem::path checkpoint_dir{};
+  long checkpoint_every = 0;
+  /// Continue from the checkpoint in checkpoint_dir instead of starting at step 0.
+  bool resume = false;
+  /// The run's settings, stored in every checkpoint (for `hnn train --resume`).
+  nlohmann::json run_settings{};
+  /// Polled after every step: when requested, training checkpoints and throws
+  /// TrainingInterrupted.
+  StopSignal* stop = nullptr;
+};
+
+/// Trains the objective's model in place. The same seed gives the same run, and a run resumed
+/// from a checkpoint ends with the same parameters, bit for bit, as one never stopped. Throws
+/// TrainingDiverged at the first step whose loss is not finite (the last checkpoint is kept).
+template <typename T>
+TrainResult train(Objective<T>& objective, const LoopOptions& options);
+
+}  // namespace hnn::tasks

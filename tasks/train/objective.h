@@ -1,0 +1,42 @@
+#pragma once
+// What the training loop trains: a model, its parameters in groups with their own optimiser
+// settings (PyTorch's param_groups), a sampler of batches and the loss of a batch. Each kind of
+// task writes one; the loop (train/loop.h) does the rest: Adam steps, the loss curve,
+// checkpoints, resume and stop.
+
+#include <cstdint>
+#include <vector>
+
+#include "autodiff/var.h"
+#include "nn/module.h"
+#include "nn/optim.h"
+#include "tasks/report/run_folder.h"
+#include "tasks/train/sampler.h"
+
+namespace hnn::tasks {
+
+template <typename T>
+struct ParameterGroup {
+  std::vector<ad::Var<T>> parameters;
+  nn::AdamOptions adam;
+};
+
+template <typename T>
+class Objective {
+ public:
+  virtual ~Objective() = default;
+  /// The model trained (its parameters and the optimisers' moments make a checkpoint).
+  virtual nn::Module<T>& model() = 0;
+  /// The groups, in order, list model().parameters() in its order.
+  virtual std::vector<ParameterGroup<T>> parameter_groups() const = 0;
+  virtual RowSampler& sampler() = 0;
+  /// The mean loss over the sampler's current batch, on the graph.
+  virtual ad::Var<T> batch_loss() = 0;
+  /// The losses of a loss-curve point, without a graph; `batch_loss` is this step's (the train
+  /// loss itself when the batch is the full training set).
+  virtual CurvePoint curve_point(long step, double batch_loss) const = 0;
+  /// A fingerprint of the training data: a checkpoint of other data is refused.
+  virtual std::uint64_t data_fingerprint() const = 0;
+};
+
+}  // namespace hnn::tasks

@@ -1,0 +1,53 @@
+#include "tasks/train/sampler.h"
+
+#include <numeric>
+#include <sstream>
+
+#include "tasks/error.h"
+
+namespace hnn::tasks {
+
+RowSampler::RowSampler(Eigen::Index rows, Eigen::Index batch, Draw draw, std::uint64_t seed)
+    : draw_(draw), rows_(rows), rng_(seed) {
+  HNN_TASKS_CHECK(rows > 0, "training data is empty");
+  HNN_TASKS_CHECK(batch >= 0 && batch <= rows,
+                  "batch size {} is out of range: the training set has {} rows", batch, rows);
+  full_ = draw == Draw::kWithReplacement && (batch == 0 || batch == rows);
+  if (full_) return;
+  batch_.resize(std::size_t(batch == 0 ? rows : batch));
+  if (draw == Draw::kWithoutReplacement) {
+    order_.resize(std::size_t(rows));
+    std::iota(order_.begin(), order_.end(), Eigen::Index(0));
+  }
+}
+
+void RowSampler::next() {
+  if (full_) return;
+  for (std::size_t i = 0; i < batch_.size(); ++i) {
+    if (draw_ == Draw::kWithReplacement) {
+      batch_[i] = std::uniform_int_distribution<Eigen::Index>(0, rows_ - 1)(rng_);
+    } else {  // one step of a Fisher-Yates shuffle
+      std::uniform_int_distribution<Eigen::Index> pick(Eigen::Index(i), rows_ - 1);
+      std::swap(order_[i], order_[std::size_t(pick(rng_))]);
+      batch_[i] = order_[i];
+    }
+  }
+}
+
+std::string RowSampler::state() const {
+  std::ostringstream out;
+  out << rng_;
+  for (Eigen::Index row : order_) out << ' ' << row;
+  return out.str();
+}
+
+void RowSampler::set_state(const std::string& state) {
+  std::istringstream in(state);
+  in >> rng_;
+  for (Eigen::Index& row : order_) in >> row;
+  HNN_TASKS_CHECK(!in.fail(), "the checkpoint's sampler state is corrupt");
+  in >> std::ws;
+  HNN_TASKS_CHECK(in.eof(), "the checkpoint's sampler state is of another sampler");
+}
+
+}  // namespace hnn::tasks
