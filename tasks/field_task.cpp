@@ -28,10 +28,7 @@ class FieldRun : public TaskRun {
   TrainResult train(const LoopOptions& loop) override {
     return with_scalar(s_.dtype, [&]<typename T>() {
       std::unique_ptr<nn::DynamicsModel<T>> model = fresh_model<T>();
-      FieldObjective<T> objective(
-          *model, data_, s_.train.batch_size,
-          {.lr = s_.train.learning_rate, .weight_decay = s_.train.weight_decay}, s_.seed);
-      const TrainResult result = tasks::train(objective, loop);
+      const TrainResult result = train_model(*model, data_, s_.train, s_.seed, loop);
       keep(std::move(model));
       return result;
     });
@@ -126,6 +123,22 @@ std::unique_ptr<FieldTask> make_field_task(const std::string& name) {
                   "task '{}' does not learn a field from states", name);
   return std::unique_ptr<FieldTask>(static_cast<FieldTask*>(task.release()));
 }
+
+template <typename T>
+TrainResult train_model(nn::DynamicsModel<T>& model, const Dataset& data, const TrainConfig& config,
+                        std::uint64_t seed, LoopOptions loop) {
+  loop.steps = config.steps;
+  loop.record_every = config.record_every;
+  FieldObjective<T> objective(model, data, config.batch_size,
+                              {.lr = config.learning_rate, .weight_decay = config.weight_decay},
+                              seed);
+  return train(objective, loop);
+}
+
+template TrainResult train_model(nn::DynamicsModel<float>&, const Dataset&, const TrainConfig&,
+                                 std::uint64_t, LoopOptions);
+template TrainResult train_model(nn::DynamicsModel<double>&, const Dataset&, const TrainConfig&,
+                                 std::uint64_t, LoopOptions);
 
 Dataset build_dataset(const std::string& task, std::uint64_t seed) {
   const std::unique_ptr<FieldTask> field_task = make_field_task(task);

@@ -32,6 +32,13 @@ class FieldTask : public Task {
 /// make_task(name) as a FieldTask; throws Error when the task learns something else.
 std::unique_ptr<FieldTask> make_field_task(const std::string& name);
 
+/// Trains `model` on `data` with FieldObjective and the training loop: steps, batch size,
+/// learning rate, weight decay and record interval from `config`, the rest (checkpoints, resume,
+/// stop, progress) from `loop`. Minibatches are drawn from a generator seeded with `seed`.
+template <typename T>
+TrainResult train_model(nn::DynamicsModel<T>& model, const Dataset& data, const TrainConfig& config,
+                        std::uint64_t seed, LoopOptions loop = {});
+
 /// The dataset of a field task with its default settings and the given seed (tests, tools).
 Dataset build_dataset(const std::string& task, std::uint64_t seed);
 
