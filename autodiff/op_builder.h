@@ -9,7 +9,9 @@
 namespace hnn::ad::detail {
 
 /// Pushes the result node of `op` on the tape. The node keeps its inputs and backward only when
-/// grad mode is on and some input requires a gradient; the caller then fills `value`.
+/// grad mode is on and some input requires a gradient; the caller then fills `value` from its
+/// own operands (never from node.inputs, which may be empty) and may attach typed state
+/// (Node::state_for). Inputs are set here once: nothing reassigns them afterwards.
 template <typename T>
 Node<T>& record(const char* op, std::span<const Var<T>> inputs, BackwardFn<T> backward) {
   Node<T>& node = Tape<T>::current().push();

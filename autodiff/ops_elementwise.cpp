@@ -4,6 +4,7 @@
 
 #include "autodiff/op_builder.h"
 #include "autodiff/ops.h"
+#include "autodiff/tanh_kernel.h"
 
 namespace hnn::ad {
 
@@ -95,21 +96,6 @@ Var<T> unary(const char* op, const Var<T>& x, BackwardFn<T> backward, F f,
 template <typename T>
 const Var<T>& in0(const Node<T>& n) {
   return n.inputs[0];
-}
-
-// Eigen vectorises tanh for float but calls the scalar libm tanh for double, which dominated
-// HNN training. For double: (1 - e^-2|x|) / (1 + e^-2|x|) with the sign restored, on the
-// vectorised exp, computed in place in the output buffer (no temporary); its absolute error is
-// a few ulps of 1 and it saturates correctly (e^-2|x| -> 0).
-template <typename T>
-void tanh_into(const Matrix<T>& x, Matrix<T>& out) {
-  if constexpr (std::is_same_v<T, float>) {
-    out = x.array().tanh().matrix();
-  } else {
-    out.resize(x.rows(), x.cols());
-    out.array() = (T(-2) * x.array().abs()).exp();
-    out.array() = (T(1) - out.array()) / (T(1) + out.array()) * x.array().sign();
-  }
 }
 
 }  // namespace
@@ -221,7 +207,8 @@ Var<T> tanh(const Var<T>& x) {
       detail::record<T>("tanh", {x}, [](const Node<T>& n, const Var<T>& g, GradSink<T>& s) {
         s.add(0, tanh_backward(g, Var<T>::of(n)));
       });
-  tanh_into(x.value(), node.value);
+  node.value.resize(x.rows(), x.cols());
+  detail::tanh_values(x.value().data(), node.value.data(), x.value().size());
   return Var<T>::of(node);
 }
 

@@ -8,6 +8,8 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <type_traits>
+#include <typeinfo>
 #include <vector>
 
 #include "autodiff/check.h"
@@ -29,6 +31,14 @@ class GradSink;
 template <typename T>
 using BackwardFn = void (*)(const Node<T>& node, const Var<T>& grad_output, GradSink<T>& sink);
 
+/// State an op keeps on its node beyond values: a fused op's layer layout, say. Each op derives
+/// its own struct with typed fields. A node keeps its state object when it is recycled, so the
+/// same op in the same tape slot next step reuses it (and its vectors' capacity): no allocation
+/// in a steady-state training step. See Node::state_for.
+struct OpState {
+  virtual ~OpState() = default;
+};
+
 template <typename T>
 struct Node {
   Matrix<T> value;
@@ -36,6 +46,7 @@ struct Node {
   BackwardFn<T> backward = nullptr;   // null for leaves and for results that need no gradient
   std::array<double, 3> saved{};      // op constants (exponent, offsets, ...)
   std::vector<Matrix<T>> buffers;     // fused ops' saved intermediates; kept across recycling
+  std::unique_ptr<OpState> state;     // typed op state (see OpState); kept across recycling
   const char* op = "leaf";
   bool requires_grad = false;
   bool is_leaf = false;
@@ -46,6 +57,28 @@ struct Node {
   int slot = -1;
   Matrix<T> grad;                     // accumulated by backward(), leaves only
   bool has_grad = false;
+
+  /// The state of the op recording this node, as S: the recycled object when the slot already
+  /// holds an S (its fields keep their old values: the op overwrites them), a new one otherwise.
+  template <typename S>
+  S& state_for() {
+    static_assert(std::is_base_of_v<OpState, S>);
+    if (!holds_state<S>()) state = std::make_unique<S>();
+    return static_cast<S&>(*state);
+  }
+  /// The state a backward formula reads: the S its op stored with state_for<S>().
+  template <typename S>
+  const S& state_as() const {
+    HNN_AD_CHECK(holds_state<S>(), "autodiff: node of op '{}' holds no {}", op, typeid(S).name());
+    return static_cast<const S&>(*state);
+  }
+  /// Whether the node's state is an S.
+  template <typename S>
+  bool holds_state() const {
+    if (!state) return false;
+    const OpState& held = *state;
+    return typeid(held) == typeid(S);
+  }
 };
 
 template <typename T>

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "autodiff/autodiff.h"
+#include "mlp_test_util.h"
 #include "test_util.h"
 
 namespace ad = hnn::ad;
@@ -18,70 +19,13 @@ using VarD = Var<double>;
 
 namespace {
 
-// An MLP layout: widths and whether the last layer has a bias.
-struct Layout {
-  std::vector<Eigen::Index> widths;
-  bool last_bias;
-  std::string name() const {
-    std::string s;
-    for (auto w : widths) s += std::to_string(w) + "_";
-    return s + (last_bias ? "bias" : "nobias");
-  }
-};
-
-// Parameter values W1, b1, W2, b2, ... (the last bias empty when absent).
-std::vector<MatrixD> parameters(const Layout& l, unsigned seed) {
-  std::vector<MatrixD> p;
-  for (std::size_t i = 0; i + 1 < l.widths.size(); ++i) {
-    p.push_back(random_matrix(l.widths[i], l.widths[i + 1], seed + 2 * unsigned(i), -0.8, 0.8));
-    const bool bias = i + 2 < l.widths.size() || l.last_bias;
-    p.push_back(bias ? random_matrix(1, l.widths[i + 1], seed + 2 * unsigned(i) + 1, -0.5, 0.5)
-                     : MatrixD());
-  }
-  return p;
-}
-
-template <typename T>
-struct Net {
-  std::vector<Var<T>> weights, biases;
-};
-
-// Splits {x, W1, b1, ...} Vars (empty-matrix biases skipped) into a Net.
-template <typename T>
-Net<T> net_of(const std::vector<Var<T>>& in, const Layout& l) {
-  Net<T> net;
-  std::size_t k = 1;
-  for (std::size_t i = 0; i + 1 < l.widths.size(); ++i) {
-    net.weights.push_back(in[k++]);
-    const bool bias = i + 2 < l.widths.size() || l.last_bias;
-    net.biases.push_back(bias ? in[k++] : Var<T>());
-  }
-  return net;
-}
-
-// The inputs as a list for the checks: x then the parameters that exist.
-std::vector<MatrixD> inputs_of(const MatrixD& x, const std::vector<MatrixD>& params) {
-  std::vector<MatrixD> in{x};
-  for (const MatrixD& p : params)
-    if (p.size() > 0) in.push_back(p);
-  return in;
-}
-
-template <typename T>
-Var<T> generic_mlp(const Var<T>& x, const Net<T>& net) {
-  Var<T> h = x;
-  for (std::size_t i = 0; i < net.weights.size(); ++i) {
-    h = ad::linear(h, net.weights[i], net.biases[i]);
-    if (i + 1 < net.weights.size()) h = ad::tanh(h);
-  }
-  return h;
-}
-
-// dy/dx through the engine's generic double backpropagation.
-template <typename T>
-Var<T> generic_input_gradient(const Var<T>& x, const Net<T>& net) {
-  return ad::grad<T>({ad::sum(generic_mlp(x, net))}, {x}, {.create_graph = true})[0];
-}
+using ad::testing::generic_input_gradient;
+using ad::testing::generic_mlp;
+using ad::testing::inputs_of;
+using ad::testing::Layout;
+using ad::testing::Net;
+using ad::testing::net_of;
+using ad::testing::parameters;
 
 const std::vector<Layout> kLayouts = {
     {{3, 5, 4, 1}, false}, {{2, 6, 1}, true}, {{4, 1}, false}, {{2, 4, 3, 5, 1}, false}};
@@ -109,7 +53,8 @@ TEST_P(FusedMlp, ValueAndFirstDerivativesMatchTheGenericNetwork) {
 
 TEST_P(FusedMlp, InputGradientAndItsDerivativesMatchDoubleBackpropagation) {
   const Layout l = GetParam();
-  if (l.widths.back() != 1) GTEST_SKIP();
+  if (l.widths.back() != 1)
+    GTEST_SKIP() << "one output per op; mlp_columns_test.cpp slices columns";
   const std::vector<MatrixD> in = inputs_of(random_matrix(150, l.widths[0], 4), parameters(l, 5));
   ad::TapeScope scope;
   std::vector<VarD> vars;
@@ -233,4 +178,49 @@ TEST(FusedMlpErrors, NameTheOpTheLayerAndTheShapes) {
     EXPECT_NE(std::string(e.what()).find("one output"), std::string::npos) << e.what();
   }
   EXPECT_THROW(ad::tanh_mlp<double>(x2, {w1}, {}), ad::Error);
+}
+
+TEST(FusedMlpLayout, HasNoLayerCap) {
+  // 40 layers of width 3 (past the 30 a bit mask in a double once allowed), biases on odd ones.
+  Layout l{std::vector<Eigen::Index>(41, 3), false};
+  l.widths.back() = 1;
+  std::vector<MatrixD> p = parameters(l, 40);
+  for (std::size_t i = 1; i < p.size(); i += 4) p[i] = MatrixD();  // every other layer: no bias
+  const std::vector<MatrixD> in = inputs_of(random_matrix(9, 3, 41), p);
+  ad::TapeScope scope;
+  std::vector<VarD> vars;
+  for (const MatrixD& m : in) vars.push_back(VarD::leaf(m));
+  Net<double> net;
+  std::size_t k = 1;
+  for (std::size_t i = 0; i < p.size(); i += 2) {
+    net.weights.push_back(vars[k++]);
+    net.biases.push_back(p[i + 1].size() > 0 ? vars[k++] : VarD());
+  }
+  EXPECT_LT(
+      (ad::tanh_mlp(vars[0], net.weights, net.biases).value() - generic_mlp(vars[0], net).value())
+          .cwiseAbs()
+          .maxCoeff(),
+      1e-13);
+  const auto gf = ad::grad<double>({ad::sum(ad::tanh_mlp(vars[0], net.weights, net.biases))}, vars);
+  const auto gg = ad::grad<double>({ad::sum(generic_mlp(vars[0], net))}, vars);
+  for (std::size_t i = 0; i < vars.size(); ++i) {
+    EXPECT_LT((gf[i].value() - gg[i].value()).cwiseAbs().maxCoeff(), 1e-12) << "input " << i;
+  }
+}
+
+TEST(FusedMlpLayout, TypedStateIsKeptByTheRecycledNode) {
+  const Layout l{{2, 6, 1}, false};
+  const std::vector<MatrixD> p = parameters(l, 42);
+  const VarD x = VarD::constant(random_matrix(4, 2, 43));
+  const VarD w1 = VarD::leaf(p[0]), b1 = VarD::leaf(p[1]), w2 = VarD::leaf(p[2]);
+  const ad::OpState* state = nullptr;
+  for (int step = 0; step < 3; ++step) {
+    ad::TapeScope scope;
+    const VarD y = ad::tanh_mlp<double>(x, {w1, w2}, {b1, VarD()});
+    ASSERT_NE(y.node().state, nullptr);
+    if (step > 0) {
+      EXPECT_EQ(y.node().state.get(), state) << "step " << step;
+    }
+    state = y.node().state.get();
+  }
 }

@@ -1,0 +1,290 @@
+// The fused tanh-MLP ops' hand-written kernels: forward passes and first-order backward passes
+// on row blocks of the batch, one per engine thread, through the GEMM of gemm.h. Values only:
+// when a backward must be recorded, ops_mlp.cpp calls mlp_recorded.cpp instead.
+//
+// Notation as in mlp_ops.h, with s_k = 1 - h_k^2 (tanh' at hidden layer k). The input gradient:
+//   a_{L-1} = W_L^T (every row),  d_k = a_k * s_k,  a_{k-1} = d_k W_k^T,  dy/dx = a_0.
+// Its backward, given G = dL/da_0, runs up the gradient chain and then down the forward chain:
+//   abar_0 = G;  dbar_k = abar_{k-1} W_k;  dW_k += abar_{k-1}^T d_k;  abar_k = dbar_k * s_k;
+//   hbar_k = -2 h_k a_k dbar_k;  dW_L = colsum(abar_{L-1})^T;
+//   then zbar_k = hbar_k * s_k (hbar_k plus zbar_{k+1} W_{k+1}^T from above), dW_k += h_{k-1}^T
+//   zbar_k, db_k = colsum(zbar_k), dx = zbar_1 W_1^T.
+// Six GEMMs of R x n x n per step for two hidden layers of width n: the minimum for this work.
+
+#include <utility>
+
+#include "autodiff/gemm.h"
+#include "autodiff/mlp_layers.h"
+#include "autodiff/op_builder.h"
+#include "autodiff/parallel.h"
+#include "autodiff/row_kernels.h"
+#include "autodiff/tanh_kernel.h"
+
+namespace hnn::ad::detail {
+
+namespace {
+
+using Eigen::Index;
+
+// Rows r of h_k: x for k = 0, else the hidden layer's buffer (h_k sits at index k - 1 in both
+// ops' buffers).
+template <typename T>
+auto hidden_block(const MlpLayers<T>& l, const std::vector<Matrix<T>>& buffers, int k, RowBlock r) {
+  const Matrix<T>& h = k == 0 ? l.x() : buffers[std::size_t(k - 1)];
+  return h.middleRows(r.begin, r.size());
+}
+
+// h_k = tanh(h_{k-1} W_k + b_k) for the hidden layers, rows r, into buffers[k - 1].
+template <typename T>
+void hidden_rows(const MlpLayers<T>& l, std::vector<Matrix<T>>& buffers, RowBlock r) {
+  for (int k = 1; k < l.count(); ++k) {
+    auto out = buffers[std::size_t(k - 1)].middleRows(r.begin, r.size());
+    gemm(hidden_block(l, std::as_const(buffers), k - 1, r), false, l.w(k), false, out);
+    if (const Var<T>* b = l.bias(k)) out.rowwise() += b->value().row(0);
+    tanh_in_place(out);
+  }
+}
+
+// One part's scratch, owned by the thread that runs the op (workers write into it).
+template <typename T>
+struct PartSpace {
+  // Per layer, so that every buffer keeps one shape from step to step (no reallocation):
+  // partial weight and bias gradients, hbar_k, and the gradient propagated to layer k.
+  std::vector<Matrix<T>> dw, db, hbar, grad;
+  void size_for(int layers) {
+    if (int(dw.size()) < layers) {
+      dw.resize(std::size_t(layers));
+      db.resize(std::size_t(layers));
+      hbar.resize(std::size_t(layers));
+      grad.resize(std::size_t(layers));
+    }
+  }
+};
+
+template <typename T>
+std::vector<PartSpace<T>>& workspace(int parts, int layers) {
+  thread_local std::vector<PartSpace<T>> space;
+  if (int(space.size()) < parts) space.resize(std::size_t(parts));
+  for (int p = 0; p < parts; ++p) space[std::size_t(p)].size_for(layers + 1);
+  return space;
+}
+
+// A node on the tape for a gradient computed in place (values only: the sweep does not record).
+template <typename T>
+Node<T>& value_node(const char* op) {
+  return record<T>(op, std::span<const Var<T>>(), nullptr);
+}
+
+// The sum of the parts' partial gradients of one parameter, handed on as input `input`.
+template <typename T>
+void add_reduced(std::vector<PartSpace<T>>& space, int parts,
+                 std::vector<Matrix<T>> PartSpace<T>::*partial, int k, int input, GradSink<T>& s,
+                 const char* op) {
+  Node<T>& g = value_node<T>(op);
+  g.value = (space[0].*partial)[std::size_t(k)];
+  for (int p = 1; p < parts; ++p) g.value += (space[std::size_t(p)].*partial)[std::size_t(k)];
+  s.add(input, Var<T>::of(g));
+}
+
+// Sums the parts' partial weight and bias gradients into gradient nodes and hands them on.
+template <typename T>
+void reduce_parameters(const MlpLayers<T>& l, std::vector<PartSpace<T>>& space, int parts,
+                       GradSink<T>& s, const char* op) {
+  for (int k = 1; k <= l.count(); ++k) {
+    const int wi = l.weight_input(k), bi = l.bias_input(k);
+    if (s.wants(wi)) add_reduced(space, parts, &PartSpace<T>::dw, k, wi, s, op);
+    if (bi >= 0 && s.wants(bi)) add_reduced(space, parts, &PartSpace<T>::db, k, bi, s, op);
+  }
+}
+
+// ---- tanh_mlp -----------------------------------------------------------------------------------
+
+// Backpropagation over rows r: partial parameter gradients into w, dx rows into dx (if wanted).
+template <typename T>
+void backprop_rows(const MlpLayers<T>& l, const Node<T>& n, const Var<T>& g, PartSpace<T>& w,
+                   RowBlock r, Matrix<T>* dx) {
+  Matrix<T>* delta = &w.grad[std::size_t(l.count())];
+  *delta = g.value().middleRows(r.begin, r.size());
+  for (int k = l.count(); k >= 1; --k) {
+    const auto prev = hidden_block(l, n.buffers, k - 1, r);
+    w.dw[std::size_t(k)].resize(prev.cols(), delta->cols());
+    gemm(prev, true, *delta, false, w.dw[std::size_t(k)]);
+    if (l.bias_input(k) >= 0) {
+      w.db[std::size_t(k)].resize(1, delta->cols());
+      column_sums(*delta, w.db[std::size_t(k)]);
+    }
+    if (k > 1) {
+      Matrix<T>* next = &w.grad[std::size_t(k - 1)];
+      next->resize(delta->rows(), l.w(k).rows());
+      gemm(*delta, false, l.w(k), true, *next);
+      next->array() *= T(1) - prev.array().square();
+      delta = next;
+    } else if (dx) {
+      gemm(*delta, false, l.w(1), true, dx->middleRows(r.begin, r.size()));
+    }
+  }
+}
+
+// ---- tanh_mlp_input_gradient ------------------------------------------------------------------
+
+// Rows r of the input gradient's buffer i.
+template <typename T>
+auto rows_of(const Node<T>& n, std::size_t i, RowBlock r) {
+  return n.buffers[i].middleRows(r.begin, r.size());
+}
+
+// Up the gradient chain for rows r: dW_k = abar_{k-1}^T d_k, hbar_k, and dW_L (each dbar_k
+// becomes abar_k in place).
+template <typename T>
+void up_the_gradient_chain(const MlpLayers<T>& l, const Node<T>& n, const Var<T>& g,
+                           PartSpace<T>& w, RowBlock r) {
+  const GradientBuffers at{l.count()};
+  Matrix<T>* abar = &w.grad[0];
+  *abar = g.value().middleRows(r.begin, r.size());
+  for (int k = 1; k < l.count(); ++k) {
+    const auto hk = rows_of(n, at.h(k), r);
+    Matrix<T>* dbar = &w.grad[std::size_t(k)];
+    dbar->resize(abar->rows(), l.w(k).cols());
+    gemm(*abar, false, l.w(k), false, *dbar);
+    w.dw[std::size_t(k)].resize(abar->cols(), l.w(k).cols());
+    gemm(*abar, true, rows_of(n, at.d(k), r), false, w.dw[std::size_t(k)]);
+    w.hbar[std::size_t(k)].resize(dbar->rows(), dbar->cols());
+    w.hbar[std::size_t(k)].array() =
+        T(-2) * hk.array() * rows_of(n, at.a(k), r).array() * dbar->array();
+    dbar->array() *= T(1) - hk.array().square();
+    abar = dbar;
+  }
+  w.dw[std::size_t(l.count())].resize(abar->cols(), 1);
+  column_sums(*abar, w.dw[std::size_t(l.count())].col(0).transpose());
+}
+
+// Down the forward chain for rows r: zbar_k in place of hbar_k, dW_k += h_{k-1}^T zbar_k, db_k,
+// and dx rows into dx (if wanted).
+template <typename T>
+void down_the_forward_chain(const MlpLayers<T>& l, const Node<T>& n, PartSpace<T>& w, RowBlock r,
+                            Matrix<T>* dx) {
+  const GradientBuffers at{l.count()};
+  Matrix<T>* hb = &w.hbar[std::size_t(l.count() - 1)];
+  for (int k = l.count() - 1; k >= 1; --k) {
+    hb->array() *= T(1) - rows_of(n, at.h(k), r).array().square();
+    gemm(hidden_block(l, n.buffers, k - 1, r), true, *hb, false, w.dw[std::size_t(k)], T(1));
+    if (l.bias_input(k) >= 0) {
+      w.db[std::size_t(k)].resize(1, hb->cols());
+      column_sums(*hb, w.db[std::size_t(k)]);
+    }
+    if (k > 1) {
+      gemm(*hb, false, l.w(k), true, w.hbar[std::size_t(k - 1)], T(1));
+      hb = &w.hbar[std::size_t(k - 1)];
+    } else if (dx) {
+      gemm(*hb, false, l.w(1), true, dx->middleRows(r.begin, r.size()));
+    }
+  }
+}
+
+// dy/dx for rows r, from the hidden layers already in the buffers: a_{L-1} = W_L^T, then
+// d_k = a_k s_k and a_{k-1} = d_k W_k^T down to a_0 = dy/dx.
+template <typename T>
+void input_gradient_rows(const MlpLayers<T>& l, Node<T>& node, RowBlock r) {
+  const int L = l.count();
+  const GradientBuffers at{L};
+  const auto block = [&](std::size_t i) { return node.buffers[i].middleRows(r.begin, r.size()); };
+  auto out = node.value.middleRows(r.begin, r.size());
+  const auto top = l.w(L).col(0).transpose();  // dy/dh_{L-1}, the same for every row
+  if (L == 1) return fill_rows(out, top);
+  fill_rows(block(at.a(L - 1)), top);
+  for (int k = L - 1; k >= 1; --k) {
+    block(at.d(k)).array() = block(at.a(k)).array() * (T(1) - block(at.h(k)).array().square());
+    const auto d = std::as_const(node.buffers[at.d(k)]).middleRows(r.begin, r.size());
+    if (k > 1) {
+      gemm(d, false, l.w(k), true, block(at.a(k - 1)));
+    } else {
+      gemm(d, false, l.w(k), true, out);
+    }
+  }
+}
+
+}  // namespace
+
+template <typename T>
+void tanh_mlp_forward(const MlpLayers<T>& l, Node<T>& node) {
+  init_gemm();
+  const int L = l.count();
+  const Index rows = l.x().rows();
+  node.buffers.resize(std::size_t(L - 1));
+  for (int k = 1; k < L; ++k) node.buffers[std::size_t(k - 1)].resize(rows, l.w(k).cols());
+  node.value.resize(rows, l.w(L).cols());
+  const int parts = parts_for(rows);
+  parallel_for(parts, [&](int p) {
+    const RowBlock r = row_block(rows, parts, p);
+    hidden_rows(l, node.buffers, r);
+    auto out = node.value.middleRows(r.begin, r.size());
+    gemm(hidden_block(l, std::as_const(node.buffers), L - 1, r), false, l.w(L), false, out);
+    if (const Var<T>* b = l.bias(L)) out.rowwise() += b->value().row(0);
+  });
+}
+
+template <typename T>
+void input_gradient_forward(const MlpLayers<T>& l, Node<T>& node) {
+  init_gemm();
+  const int L = l.count();
+  const GradientBuffers at{L};
+  const Index rows = l.x().rows();
+  node.buffers.resize(at.size());
+  for (int k = 1; k < L; ++k) {
+    for (std::size_t i : {at.h(k), at.a(k), at.d(k)}) node.buffers[i].resize(rows, l.w(k).cols());
+  }
+  node.value.resize(rows, l.x().cols());
+  const int parts = parts_for(rows);
+  parallel_for(parts, [&](int p) {
+    const RowBlock r = row_block(rows, parts, p);
+    hidden_rows(l, node.buffers, r);
+    input_gradient_rows(l, node, r);
+  });
+}
+
+template <typename T>
+void tanh_mlp_backward_kernel(const Node<T>& n, const Var<T>& g, GradSink<T>& s) {
+  const MlpLayers<T> l = layers_of(n);
+  const Index rows = g.rows();
+  const int parts = parts_for(rows);
+  std::vector<PartSpace<T>>& space = workspace<T>(parts, l.count());
+  Node<T>* dx_node = s.wants(0) ? &value_node<T>("tanh_mlp_grad") : nullptr;
+  if (dx_node) dx_node->value.resize(rows, l.x().cols());
+  parallel_for(parts, [&](int p) {
+    backprop_rows(l, n, g, space[std::size_t(p)], row_block(rows, parts, p),
+                  dx_node ? &dx_node->value : nullptr);
+  });
+  if (dx_node) s.add(0, Var<T>::of(*dx_node));
+  reduce_parameters(l, space, parts, s, "tanh_mlp_grad");
+}
+
+template <typename T>
+void input_gradient_backward_kernel(const Node<T>& n, const Var<T>& g, GradSink<T>& s) {
+  const MlpLayers<T> l = layers_of(n);
+  const Index rows = g.rows();
+  const int parts = parts_for(rows);
+  std::vector<PartSpace<T>>& space = workspace<T>(parts, l.count());
+  // With no hidden layer dy/dx = W^T does not depend on x.
+  const bool wants_dx = s.wants(0) && l.count() > 1;
+  Node<T>* dx_node = wants_dx ? &value_node<T>("tanh_mlp_input_gradient_grad") : nullptr;
+  if (dx_node) dx_node->value.resize(rows, l.x().cols());
+  parallel_for(parts, [&](int p) {
+    const RowBlock r = row_block(rows, parts, p);
+    PartSpace<T>& w = space[std::size_t(p)];
+    up_the_gradient_chain(l, n, g, w, r);
+    down_the_forward_chain(l, n, w, r, dx_node ? &dx_node->value : nullptr);
+  });
+  if (dx_node) s.add(0, Var<T>::of(*dx_node));
+  reduce_parameters(l, space, parts, s, "tanh_mlp_input_gradient_grad");
+}
+
+#define HNN_INSTANTIATE(T)                                                             \
+  template void tanh_mlp_forward(const MlpLayers<T>&, Node<T>&);                       \
+  template void input_gradient_forward(const MlpLayers<T>&, Node<T>&);                 \
+  template void tanh_mlp_backward_kernel(const Node<T>&, const Var<T>&, GradSink<T>&); \
+  template void input_gradient_backward_kernel(const Node<T>&, const Var<T>&, GradSink<T>&);
+HNN_INSTANTIATE(float)
+HNN_INSTANTIATE(double)
+#undef HNN_INSTANTIATE
+
+}  // namespace hnn::ad::detail

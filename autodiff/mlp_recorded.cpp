@@ -1,0 +1,99 @@
+// The fused tanh-MLP ops' recorded backward passes: the formulas of mlp_kernels.cpp written in
+// differentiable ops on a recomputed forward pass, used when the backward itself is recorded
+// (create_graph), so that derivatives of any order work. The recomputed h_k equal the fused
+// forward's bit for bit (same GEMM on the same row blocks, the one tanh kernel).
+
+#include "autodiff/mlp_layers.h"
+#include "autodiff/ops.h"
+
+namespace hnn::ad::detail {
+
+namespace {
+
+// h_0 = x, h_k = tanh(h_{k-1} W_k + b_k) for the hidden layers k = 1..L-1, as ops.
+template <typename T>
+std::vector<Var<T>> hidden_layers(const MlpLayers<T>& l) {
+  std::vector<Var<T>> h{l.x_var()};
+  for (int k = 1; k < l.count(); ++k) {
+    const Var<T>* b = l.bias(k);
+    h.push_back(tanh(linear(h.back(), l.weight(k), b ? *b : Var<T>())));
+  }
+  return h;
+}
+
+// Adds make_grad() as the gradient of input i (-1: none), only when the sweep wants it.
+template <typename T>
+void add_if_wanted(GradSink<T>& s, int i, const auto& make_grad) {
+  if (i >= 0 && s.wants(i)) s.add(i, make_grad());
+}
+
+// The input gradient's a_k and d_k (mlp_kernels.cpp), as ops: a_{L-1} = W_L^T on every row,
+// d_k = a_k s_k, a_{k-1} = d_k W_k^T.
+template <typename T>
+void gradient_chain(const MlpLayers<T>& l, const std::vector<Var<T>>& h, Eigen::Index rows,
+                    std::vector<Var<T>>& a, std::vector<Var<T>>& d) {
+  const int L = l.count();
+  a.assign(std::size_t(L), Var<T>());
+  d.assign(std::size_t(L), Var<T>());
+  a[std::size_t(L - 1)] = broadcast_to(transpose(l.weight(L)), rows, l.weight(L).rows());
+  for (int k = L - 1; k >= 1; --k) {
+    d[std::size_t(k)] = tanh_backward(a[std::size_t(k)], h[std::size_t(k)]);
+    a[std::size_t(k - 1)] = matmul(d[std::size_t(k)], l.weight(k), false, true);
+  }
+}
+
+}  // namespace
+
+template <typename T>
+void tanh_mlp_backward_recorded(const MlpLayers<T>& l, const Var<T>& g, GradSink<T>& s) {
+  const std::vector<Var<T>> h = hidden_layers(l);
+  Var<T> delta = g;
+  for (int k = l.count(); k >= 1; --k) {
+    const Var<T>& prev = h[std::size_t(k - 1)];
+    add_if_wanted(s, l.weight_input(k), [&] { return matmul(prev, delta, true, false); });
+    add_if_wanted(s, l.bias_input(k), [&] { return sum_rows(delta); });
+    if (k > 1) {
+      delta = tanh_backward(matmul(delta, l.weight(k), false, true), prev);
+    } else {
+      add_if_wanted(s, 0, [&] { return matmul(delta, l.weight(1), false, true); });
+    }
+  }
+}
+
+template <typename T>
+void input_gradient_backward_recorded(const MlpLayers<T>& l, const Var<T>& g, GradSink<T>& s) {
+  const int L = l.count();
+  const std::vector<Var<T>> h = hidden_layers(l);
+  std::vector<Var<T>> a, d, hbar(static_cast<std::size_t>(L));
+  gradient_chain(l, h, g.rows(), a, d);
+  Var<T> abar = g;  // up the gradient chain
+  for (int k = 1; k < L; ++k) {
+    const Var<T> dbar = matmul(abar, l.weight(k));
+    add_if_wanted(s, l.weight_input(k),
+                  [&] { return matmul(abar, d[std::size_t(k)], true, false); });
+    hbar[std::size_t(k)] = T(-2) * h[std::size_t(k)] * a[std::size_t(k)] * dbar;
+    abar = tanh_backward(dbar, h[std::size_t(k)]);
+  }
+  add_if_wanted(s, l.weight_input(L), [&] { return transpose(sum_rows(abar)); });
+  Var<T> hb = hbar[std::size_t(L - 1)];  // down the forward chain
+  for (int k = L - 1; k >= 1; --k) {
+    const Var<T> zbar = tanh_backward(hb, h[std::size_t(k)]);
+    add_if_wanted(s, l.weight_input(k),
+                  [&] { return matmul(h[std::size_t(k - 1)], zbar, true, false); });
+    add_if_wanted(s, l.bias_input(k), [&] { return sum_rows(zbar); });
+    if (k > 1) {
+      hb = hbar[std::size_t(k - 1)] + matmul(zbar, l.weight(k), false, true);
+    } else {
+      add_if_wanted(s, 0, [&] { return matmul(zbar, l.weight(1), false, true); });
+    }
+  }
+}
+
+#define HNN_INSTANTIATE(T)                                                                    \
+  template void tanh_mlp_backward_recorded(const MlpLayers<T>&, const Var<T>&, GradSink<T>&); \
+  template void input_gradient_backward_recorded(const MlpLayers<T>&, const Var<T>&, GradSink<T>&);
+HNN_INSTANTIATE(float)
+HNN_INSTANTIATE(double)
+#undef HNN_INSTANTIATE
+
+}  // namespace hnn::ad::detail

@@ -1,0 +1,76 @@
+// One tanh kernel: the elementwise op and the fused MLP kernels give the same bits, whatever the
+// batch size, the thread count (row blocks start anywhere in memory) or the scalar type.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "autodiff/autodiff.h"
+#include "test_util.h"
+
+namespace ad = hnn::ad;
+using ad::Var;
+using ad::testing::random_matrix;
+
+namespace {
+
+// A hidden layer through the fused op: tanh_mlp(x, {W, I}) = tanh(x W + b) I, and multiplying by
+// the identity is exact, so the fused op's output is its hidden layer's tanh values.
+template <typename T>
+ad::Matrix<T> fused_hidden_layer(const Var<T>& x, const Var<T>& w, const Var<T>& b) {
+  const Var<T> identity = Var<T>::constant(ad::Matrix<T>::Identity(w.cols(), w.cols()));
+  return ad::tanh_mlp<T>(x, {w, identity}, {b, Var<T>()}).value();
+}
+
+template <typename T>
+void expect_fused_and_generic_tanh_identical() {
+  for (int threads : {1, 2}) {
+    ad::set_num_threads(threads);
+    for (Eigen::Index rows : {1, 7, 150, 333}) {
+      ad::TapeScope scope;
+      const Var<T> x = Var<T>::leaf(random_matrix(rows, 3, 31, -3, 3).cast<T>());
+      const Var<T> w = Var<T>::leaf(random_matrix(3, 21, 32).cast<T>());
+      const Var<T> b = Var<T>::leaf(random_matrix(1, 21, 33).cast<T>());
+      const ad::Matrix<T> generic = ad::tanh(ad::linear(x, w, b)).value();
+      EXPECT_EQ(fused_hidden_layer(x, w, b), generic) << rows << " rows, " << threads << " threads";
+    }
+  }
+  ad::set_num_threads(2);
+}
+
+TEST(TanhKernel, FusedAndGenericForwardGiveBitIdenticalValues) {
+  expect_fused_and_generic_tanh_identical<double>();
+  expect_fused_and_generic_tanh_identical<float>();
+}
+
+template <typename T>
+void expect_position_independent() {
+  ad::TapeScope scope;
+  const ad::Matrix<T> x = random_matrix(1, 200, 34, -4, 4).cast<T>();
+  const ad::Matrix<T> whole = ad::tanh(Var<T>::constant(x)).value();
+  for (Eigen::Index start : {1, 3, 67}) {  // an element's value must not depend on its address
+    const ad::Matrix<T> part = x.rightCols(x.cols() - start);
+    EXPECT_EQ(ad::tanh(Var<T>::constant(part)).value(), whole.rightCols(x.cols() - start))
+        << "from column " << start;
+  }
+}
+
+TEST(TanhKernel, ValueDoesNotDependOnWhereTheElementSits) {
+  expect_position_independent<double>();
+  expect_position_independent<float>();
+}
+
+TEST(TanhKernel, SaturatesAndPropagatesNan) {
+  ad::TapeScope scope;
+  const double inf = std::numeric_limits<double>::infinity();
+  ad::Matrix<double> x(1, 6);
+  x << -inf, -800, -20, 20, 800, inf;
+  const ad::Matrix<double> y = ad::tanh(Var<double>::constant(x)).value();
+  for (Eigen::Index i = 0; i < 6; ++i) EXPECT_EQ(y(0, i), x(0, i) < 0 ? -1.0 : 1.0) << x(0, i);
+  ad::Matrix<double> nan(1, 1);
+  nan << std::nan("");
+  EXPECT_TRUE(std::isnan(ad::tanh(Var<double>::constant(nan)).value()(0, 0)));
+}
+
+}  // namespace
