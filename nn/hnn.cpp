@@ -4,7 +4,6 @@
 
 #include <stdexcept>
 
-#include "autodiff/grad.h"
 #include "autodiff/ops.h"
 #include "autodiff/tape.h"
 
@@ -19,6 +18,17 @@ const DynamicsConfig& require(const DynamicsConfig& config, ModelKind kind) {
   }
   validate(config);
   return config;
+}
+
+// (dH/dp, -dH/dq) from dH/dx = (dH/dq, dH/dp).
+template <typename T>
+ad::Var<T> symplectic_gradient(const ad::Var<T>& dh) {
+  const Index n = dh.cols() / 2;
+  thread_local std::vector<ad::Var<T>> halves;  // reused: no allocation per step
+  halves.assign({ad::slice_cols(dh, n, n), -ad::slice_cols(dh, 0, n)});
+  const ad::Var<T> field = ad::concat_cols<T>(halves);
+  halves.clear();
+  return field;
 }
 
 }  // namespace
@@ -61,43 +71,19 @@ ad::Var<T> Hnn<T>::dissipation(const ad::Var<T>& x) const {
   return out.cols() == 1 ? out : ad::slice_cols(out, 1, 1);
 }
 
+// One formula for every field type: H is the MLP's column 0 and D its last column (1 for kBoth,
+// 0 for kConservative). In training, Mlp::input_gradient also gives the exact parameter
+// gradients of each part (through one fused op for a tanh MLP).
 template <typename T>
 typename Hnn<T>::Parts Hnn<T>::time_derivative_parts(const ad::Var<T>& x) const {
   this->check_input("time_derivative", x.rows(), x.cols());
   const FieldType field = this->config_.field;
   Parts parts;
-  if (field != FieldType::kBoth && this->mlp_.has_fused_input_gradient()) {
-    // One fused op gives dH/dx (or dD/dx) and, in training, its exact parameter gradients.
-    const ad::Var<T> dh = this->mlp_.input_gradient(x);
-    if (field == FieldType::kConservative) {
-      parts.conservative = dh;
-    } else {
-      const Index n = this->config_.dim / 2;
-      thread_local std::vector<ad::Var<T>> halves;  // reused: no allocation per step
-      halves.assign({ad::slice_cols(dh, n, n), -ad::slice_cols(dh, 0, n)});
-      parts.solenoidal = ad::concat_cols<T>(halves);
-      halves.clear();
-    }
-    return parts;
-  }
-  // Training (grad mode on) keeps the derivative on the graph; under a NoGradGuard it is a
-  // value. Either way the scalars themselves must be recorded to be differentiated.
-  const bool create_graph = ad::grad_enabled();
-  ad::GradModeGuard record(true);
-  const ad::Var<T> input = x.requires_grad() ? x : ad::Var<T>::leaf(x.value());
-  const ad::Var<T> out = this->mlp_.forward(input);
-  const ad::GradOptions options{.create_graph = create_graph, .allow_unused = true};
-  const auto gradient_of_column = [&](Index column) {
-    const ad::Var<T> scalar = out.cols() == 1 ? out : ad::slice_cols(out, column, 1);
-    return ad::grad<T>({ad::sum(scalar)}, {input}, options)[0];
-  };
   if (field != FieldType::kConservative) {
-    const ad::Var<T> dh = gradient_of_column(0);
-    const Index n = this->config_.dim / 2;
-    parts.solenoidal = ad::concat_cols<T>({ad::slice_cols(dh, n, n), -ad::slice_cols(dh, 0, n)});
+    parts.solenoidal = symplectic_gradient(this->mlp_.input_gradient(x, 0));
   }
   if (field != FieldType::kSolenoidal) {
-    parts.conservative = gradient_of_column(field == FieldType::kBoth ? 1 : 0);
+    parts.conservative = this->mlp_.input_gradient(x, this->mlp_.output_dim() - 1);
   }
   return parts;
 }

@@ -10,9 +10,10 @@
 namespace hnn::nn {
 
 /// An HNN: an MLP maps x = (q, p) to learned scalars, and the field is built from their
-/// gradients (see FieldType). The solenoidal part (dH/dp, -dH/dq) uses
-/// grad(sum(H(x)), x, create_graph) on x itself when x requires gradients (so a loss can reach
-/// an encoder that produced x) and on a leaf copy of x otherwise.
+/// gradients (see FieldType): the solenoidal part (dH/dp, -dH/dq) from dH/dx, the conservative
+/// part dD/dx, each one Mlp::input_gradient (a fused op for a tanh MLP, ad::grad with
+/// create_graph otherwise), differentiable in x too, so a loss can reach an encoder that
+/// produced x.
 template <typename T>
 class Hnn : public DynamicsModel<T> {
  public:

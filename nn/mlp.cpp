@@ -5,7 +5,10 @@
 
 #include <stdexcept>
 
+#include "autodiff/grad.h"
 #include "autodiff/mlp_ops.h"
+#include "autodiff/ops.h"
+#include "autodiff/tape.h"
 
 namespace hnn::nn {
 
@@ -20,6 +23,35 @@ void validate(const MlpConfig& config) {
     if (w < 1)
       throw std::invalid_argument(fmt::format("Mlp: widths {} must be >= 1", config.widths));
   }
+}
+
+// The fused op differentiates a single output: with several, it runs on the column's slice of the
+// last weight (slice_cols is differentiable, so that column of the weight gets its gradient).
+template <typename T>
+ad::Var<T> fused_input_gradient(const ad::Var<T>& x, const std::vector<ad::Var<T>>& weights,
+                                const std::vector<ad::Var<T>>& biases, Index column) {
+  if (weights.back().cols() == 1) return ad::tanh_mlp_input_gradient(x, weights, biases);
+  thread_local std::vector<ad::Var<T>> sliced;  // reused: no allocation per step
+  sliced.assign(weights.begin(), weights.end());
+  sliced.back() = ad::slice_cols(weights.back(), column, 1);
+  const ad::Var<T> gradient = ad::tanh_mlp_input_gradient(x, sliced, biases);
+  sliced.clear();  // release the parameters' handles (capacity stays)
+  return gradient;
+}
+
+// Any activation, through the engine's double backpropagation. Training (grad mode on) keeps the
+// derivative on the graph; under a NoGradGuard it is a value. Either way the forward pass must
+// be recorded to be differentiated, on x itself when x requires gradients (so that a loss
+// reaches whatever produced x) and on a leaf copy otherwise.
+template <typename T>
+ad::Var<T> generic_input_gradient(const Mlp<T>& mlp, const ad::Var<T>& x, Index column) {
+  const bool create_graph = ad::grad_enabled();
+  ad::GradModeGuard record(true);
+  const ad::Var<T> input = x.requires_grad() ? x : ad::Var<T>::leaf(x.value());
+  const ad::Var<T> out = mlp.forward(input);
+  const ad::Var<T> y = out.cols() == 1 ? out : ad::slice_cols(out, column, 1);
+  const ad::GradOptions options{.create_graph = create_graph, .allow_unused = true};
+  return ad::grad<T>({ad::sum(y)}, {input}, options)[0];
 }
 
 }  // namespace
@@ -85,12 +117,16 @@ ad::Var<T> Mlp<T>::forward(const ad::Var<T>& x) const {
 }
 
 template <typename T>
-ad::Var<T> Mlp<T>::input_gradient(const ad::Var<T>& x) const {
-  if (!has_fused_input_gradient()) {
-    throw std::logic_error(fmt::format(
-        "Mlp::input_gradient: needs a tanh MLP with one output, not {}", describe(config_)));
+ad::Var<T> Mlp<T>::input_gradient(const ad::Var<T>& x, Index column) const {
+  if (column < 0 || column >= output_dim()) {
+    throw std::invalid_argument(fmt::format("Mlp::input_gradient: column {} of an MLP with {} {}",
+                                            column, output_dim(),
+                                            output_dim() == 1 ? "output" : "outputs"));
   }
-  return ad::tanh_mlp_input_gradient(x, weights_, biases_);
+  if (config_.activation == Activation::kTanh) {
+    return fused_input_gradient(x, weights_, biases_, column);
+  }
+  return generic_input_gradient(*this, x, column);
 }
 
 template <typename T>

@@ -36,13 +36,12 @@ class Mlp : public Module<T> {
 
   /// A tanh MLP runs as one fused op (ad::tanh_mlp); other activations layer by layer.
   ad::Var<T> forward(const ad::Var<T>& x) const;
-  /// For a tanh MLP with one output: d y / d x row by row, as one fused op that training can
-  /// differentiate (ad::tanh_mlp_input_gradient). Throws std::logic_error otherwise.
-  ad::Var<T> input_gradient(const ad::Var<T>& x) const;
-  /// Whether input_gradient() is available.
-  bool has_fused_input_gradient() const {
-    return config_.activation == Activation::kTanh && output_dim() == 1;
-  }
+  /// d y[:, column] / d x row by row (R x in: an HNN's dH/dx), differentiable in x and in every
+  /// parameter, so a loss can be differentiated through it (the HNN's second-order path). A tanh
+  /// MLP runs it as one fused op (ad::tanh_mlp_input_gradient, on the column's slice of the last
+  /// weight when there are several outputs); other activations run ad::grad with create_graph.
+  /// Throws std::invalid_argument for a column outside [0, output_dim()).
+  ad::Var<T> input_gradient(const ad::Var<T>& x, Index column = 0) const;
 
   const MlpConfig& config() const { return config_; }
   const std::vector<Linear<T>>& layers() const { return layers_; }

@@ -64,11 +64,13 @@ namespace {
 
 // Heap allocations made by `steps` training steps of `kind` after `warmup` steps.
 template <typename T>
-long allocations_per_steps(nn::ModelKind kind, int threads, long rows, int warmup, int steps) {
+long allocations_per_steps(nn::ModelKind kind, int threads, long rows, int warmup, int steps,
+                           nn::FieldType field = nn::FieldType::kSolenoidal) {
   ad::set_num_threads(threads);
   std::mt19937_64 rng(3);
   nn::DynamicsConfig config;
   config.model = kind;
+  config.field = field;
   config.dim = 2;
   config.hidden = {64, 64};
   const auto model = nn::make_model<T>(config, rng);
@@ -108,6 +110,10 @@ TEST(Allocations, TrainingStepsAllocateNothingAfterWarmUp) {
         << "HNN, float, " << threads << " thread(s)";
     EXPECT_EQ((allocations_per_steps<double>(nn::ModelKind::kBaseline, threads, 300, 3, 20)), 0)
         << "baseline, double, " << threads << " thread(s)";
+    EXPECT_EQ((allocations_per_steps<double>(nn::ModelKind::kHnn, threads, 300, 3, 20,
+                                             nn::FieldType::kBoth)),
+              0)
+        << "dissipative HNN (kBoth), double, " << threads << " thread(s)";
   }
 }
 

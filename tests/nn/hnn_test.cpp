@@ -66,20 +66,24 @@ TEST(Hnn, TrainingLossMatchesFiniteDifferencesUpToSecondOrder) {
   }
 }
 
-TEST(Hnn, FieldOfEveryActivationMatchesFiniteDifferences) {
-  for (const nn::Activation act :
-       {nn::Activation::kTanh, nn::Activation::kSigmoid, nn::Activation::kSoftplus,
-        nn::Activation::kElu, nn::Activation::kSelu, nn::Activation::kSwish}) {
-    std::mt19937_64 rng(6);
-    const nn::Hnn<double> hnn(small_config(ModelKind::kHnn, 4, {6}, FieldType::kSolenoidal, act),
-                              rng);
-    const auto f = [&](const std::vector<Var<double>>& in) {
-      const_cast<nn::Hnn<double>&>(hnn).bind_parameters(
-          std::vector<Var<double>>(in.begin() + 1, in.end()));
-      return hnn.time_derivative(in[0]);
-    };
-    const ad::CheckResult r = ad::gradcheck(f, inputs_of(hnn, random_states(3, 4, 7)));
-    EXPECT_TRUE(r.ok) << nn::to_string(act) << ": " << r.worst << "\n" << r.log;
+TEST(Hnn, FieldOfEveryActivationAndFieldTypeMatchesFiniteDifferences) {
+  for (const FieldType field :
+       {FieldType::kSolenoidal, FieldType::kConservative, FieldType::kBoth}) {
+    for (const nn::Activation act :
+         {nn::Activation::kTanh, nn::Activation::kSigmoid, nn::Activation::kSoftplus,
+          nn::Activation::kElu, nn::Activation::kSelu, nn::Activation::kSwish}) {
+      std::mt19937_64 rng(6);
+      const nn::Hnn<double> hnn(small_config(ModelKind::kHnn, 4, {6}, field, act), rng);
+      const auto f = [&](const std::vector<Var<double>>& in) {
+        const_cast<nn::Hnn<double>&>(hnn).bind_parameters(
+            std::vector<Var<double>>(in.begin() + 1, in.end()));
+        return hnn.time_derivative(in[0]);
+      };
+      const ad::CheckResult r = ad::gradcheck(f, inputs_of(hnn, random_states(3, 4, 7)));
+      EXPECT_TRUE(r.ok) << nn::to_string(field) << ", " << nn::to_string(act) << ": " << r.worst
+                        << "\n"
+                        << r.log;
+    }
   }
 }
 
@@ -131,6 +135,58 @@ TEST(Hnn, ConservativeFieldIsTheGradientOfTheDissipationAndBothIsTheSum) {
       [&](const Var<double>& row) { return conservative.time_derivative(row); }, x.row(0));
   EXPECT_NEAR(jac(0, 1), jac(1, 0), 1e-14 * jac.cwiseAbs().maxCoeff());
   EXPECT_GT(std::abs(jac.trace()), 1e-6);
+}
+
+// The dissipative field (dH/dp, -dH/dq) + dD/dx written with the engine's generic double
+// backpropagation through the MLP's forward pass: the formula the fused route must reproduce.
+template <typename T>
+Var<T> generic_dissipative_field(const nn::Hnn<T>& hnn, const Var<T>& x) {
+  const Var<T> out = hnn.mlp().forward(x);
+  const auto gradient_of_column = [&](Eigen::Index column) {
+    const Var<T> y = ad::slice_cols(out, column, 1);
+    return ad::grad<T>({ad::sum(y)}, {x}, {.create_graph = true})[0];
+  };
+  const Var<T> dh = gradient_of_column(0), dd = gradient_of_column(1);
+  const Eigen::Index n = x.cols() / 2;
+  return ad::concat_cols<T>({ad::slice_cols(dh, n, n), -ad::slice_cols(dh, 0, n)}) + dd;
+}
+
+// The field, the loss's parameter gradients, and second derivatives (the parameter gradient of
+// the squared norm of those gradients) of a kBoth HNN, fused or generic.
+template <typename T>
+std::vector<nn::Matrix<T>> dissipative_derivatives(bool fused) {
+  std::mt19937_64 rng(26);
+  const nn::Hnn<T> hnn(small_config(ModelKind::kHnn, 4, {16, 16}, FieldType::kBoth), rng);
+  ad::TapeScope scope;
+  const Var<T> x = Var<T>::leaf(random_states(90, 4, 27).cast<T>());
+  const Var<T> target = Var<T>::constant(random_states(90, 4, 28).cast<T>());
+  const Var<T> field = fused ? hnn.time_derivative(x) : generic_dissipative_field(hnn, x);
+  const std::vector<Var<T>> params = hnn.parameters();
+  const std::vector<Var<T>> first =
+      ad::grad<T>({nn::mse(field, target)}, params, {.create_graph = true});
+  Var<T> norm = ad::sum(ad::square(first[0]));
+  for (std::size_t i = 1; i < first.size(); ++i) norm = norm + ad::sum(ad::square(first[i]));
+  const std::vector<Var<T>> second = ad::grad<T>({norm}, params, {.allow_unused = true});
+  std::vector<nn::Matrix<T>> out{field.value()};
+  for (const Var<T>& g : first) out.push_back(g.value());
+  for (const Var<T>& g : second) out.push_back(g.value());
+  return out;
+}
+
+template <typename T>
+void expect_dissipative_routes_agree(double tolerance) {
+  const auto fused = dissipative_derivatives<T>(true), generic = dissipative_derivatives<T>(false);
+  ASSERT_EQ(fused.size(), generic.size());
+  for (std::size_t i = 0; i < fused.size(); ++i) {
+    const double scale = std::max(1.0, double(generic[i].cwiseAbs().maxCoeff()));
+    EXPECT_LT(double((fused[i] - generic[i]).cwiseAbs().maxCoeff()), tolerance * scale)
+        << "entry " << i << " (0: field, then first and second derivatives)";
+  }
+}
+
+TEST(Hnn, DissipativeFieldMatchesTheGenericFormulaToSecondOrder) {
+  expect_dissipative_routes_agree<double>(1e-12);
+  expect_dissipative_routes_agree<float>(1e-4);
 }
 
 TEST(Hnn, DerivativeReachesTheModelThatProducedItsInput) {

@@ -100,6 +100,25 @@ TEST(Mlp, EveryActivationMatchesFiniteDifferences) {
   }
 }
 
+TEST(Mlp, InputGradientOfEachColumnMatchesFiniteDifferencesToSecondOrder) {
+  // tanh: one fused op on the column's slice of the last weight; softplus: ad::grad.
+  for (const nn::Activation act : {nn::Activation::kTanh, nn::Activation::kSoftplus}) {
+    std::mt19937_64 rng(6);
+    nn::Mlp<double> mlp({{3, 5, 4, 3}, act, nn::Init::kXavierNormal, false}, rng);
+    const MatrixD x = nn::random_normal<double>(4, 3, rng);
+    for (Eigen::Index column = 0; column < 3; ++column) {
+      const auto gradient = [&](const Var<double>& in) { return mlp.input_gradient(in, column); };
+      const ad::CheckResult first = check_module(mlp, x, gradient);
+      EXPECT_TRUE(first.ok) << nn::to_string(act) << " column " << column << ": " << first.log;
+      const ad::CheckResult second = check_module(mlp, x, gradient, /*second_order=*/true);
+      EXPECT_TRUE(second.ok) << nn::to_string(act) << " column " << column << ": " << second.log;
+    }
+    ad::TapeScope scope;
+    EXPECT_THROW(mlp.input_gradient(Var<double>::constant(x), 3), std::invalid_argument);
+    EXPECT_THROW(mlp.input_gradient(Var<double>::constant(x), -1), std::invalid_argument);
+  }
+}
+
 TEST(Mlp, NamesAndConfigErrorsAreClear) {
   std::mt19937_64 rng(5);
   EXPECT_THROW(nn::Mlp<double>({{3}}, rng), std::invalid_argument);
