@@ -16,7 +16,7 @@ class Error : public std::runtime_error {
 }  // namespace hnn::tasks
 
 /// Throws tasks::Error with the fmt-formatted message unless `cond` holds.
-#define HNN_TASKS_CHECK(cond, ...)                                      \
-  do {                                                                  \
+#define HNN_TASKS_CHECK(cond, ...)                                    \
+  do {                                                                \
     if (!(cond)) throw ::hnn::tasks::Error(fmt::format(__VA_ARGS__)); \
   } while (false)

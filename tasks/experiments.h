@@ -8,11 +8,11 @@
 
 namespace hnn::tasks {
 
-std::unique_ptr<Task> make_spring_task();         // spring.cpp
-std::unique_ptr<Task> make_pendulum_task();       // pendulum.cpp
-std::unique_ptr<Task> make_real_pendulum_task();  // real_pendulum.cpp
-std::unique_ptr<Task> make_two_body_task();       // nbody.cpp
-std::unique_ptr<Task> make_three_body_task();     // nbody.cpp
+std::unique_ptr<Task> make_spring_task();          // spring.cpp
+std::unique_ptr<Task> make_pendulum_task();        // pendulum.cpp
+std::unique_ptr<Task> make_real_pendulum_task();   // real_pendulum.cpp
+std::unique_ptr<Task> make_two_body_task();        // nbody.cpp
+std::unique_ptr<Task> make_three_body_task();      // nbody.cpp
 std::unique_ptr<Task> make_pixel_pendulum_task();  // pixel_pendulum.cpp
 
 }  // namespace hnn::tasks

@@ -140,10 +140,12 @@ template TrainResult train_model(nn::DynamicsModel<float>&, const Dataset&, cons
 template TrainResult train_model(nn::DynamicsModel<double>&, const Dataset&, const TrainConfig&,
                                  std::uint64_t, LoopOptions);
 
+Dataset FieldTask::build_dataset(std::uint64_t seed) const {
+  return build_dataset(RunSettings{.task = name(), .seed = seed});
+}
+
 Dataset build_dataset(const std::string& task, std::uint64_t seed) {
-  const std::unique_ptr<FieldTask> field_task = make_field_task(task);
-  RunSettings settings{.task = task, .seed = seed};
-  return field_task->build_dataset(settings);
+  return make_field_task(task)->build_dataset(seed);
 }
 
 }  // namespace hnn::tasks

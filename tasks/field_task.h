@@ -19,6 +19,8 @@ class FieldTask : public Task {
  public:
   /// Deterministic: the same seed (and data file) give the same data, bit for bit.
   virtual Dataset build_dataset(const RunSettings& settings) const = 0;
+  /// build_dataset with the task's default settings and this seed.
+  Dataset build_dataset(std::uint64_t seed) const;
   /// The ground truth for rollouts and energies (a fitted H for measured data).
   virtual const physics::System& truth() const = 0;
   /// Initial states of the energy-metric rollouts.

@@ -1,6 +1,7 @@
 // Tasks 4 and 4b: two and three bodies under gravity in the plane (masses 1, G = 1).
 
 #include "physics/nbody.h"
+
 #include "tasks/data/trajectories.h"
 #include "tasks/experiments.h"
 #include "tasks/field_task.h"

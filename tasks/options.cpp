@@ -48,8 +48,7 @@ void check_train_config(const TrainConfig& c) {
                   "weight decay must be a finite number >= 0, got {}", c.weight_decay);
   HNN_TASKS_CHECK(!c.hidden.empty(), "--hidden needs at least one width");
   for (int w : c.hidden) {
-    HNN_TASKS_CHECK(w > 0 && w <= kMaxWidth, "--hidden widths must be 1..{}, got {}", kMaxWidth,
-                    w);
+    HNN_TASKS_CHECK(w > 0 && w <= kMaxWidth, "--hidden widths must be 1..{}, got {}", kMaxWidth, w);
   }
 }
 

@@ -21,15 +21,17 @@ class PendulumTask : public FieldTask {
   // The `lean` preset (docs/speed_accuracy.md, chart 4): within the noise of 200-200.
   std::vector<int> lean_hidden() const override { return {32, 32}; }
   Dataset build_dataset(const RunSettings& settings) const override {
-    return oscillator_dataset(pendulum_, settings.seed, {.trajectories = 50, .points = 45, .t_end = 3.0});
+    return oscillator_dataset(pendulum_, settings.seed,
+                              {.trajectories = 50, .points = 45, .t_end = 3.0});
   }
   const physics::System& truth() const override { return pendulum_; }
   Batch rollout_states(const Dataset&, std::mt19937_64& rng) const override {
     return physics::sample_evaluation_states(rollout_config().trajectories, rng);
   }
   PaperRow paper(nn::ModelKind model) const override {
-    return model == nn::ModelKind::kHnn ? PaperRow{{3.2787e-2, 1.8e-3}, {3.5586e-2, 1.8e-3}, {2.4852e-2, 5.4e-3}}
-                          : PaperRow{{3.2606e-2, 1.7e-3}, {3.5273e-2, 1.8e-3}, {4.1519e-2, 9.6e-3}};
+    return model == nn::ModelKind::kHnn
+               ? PaperRow{{3.2787e-2, 1.8e-3}, {3.5586e-2, 1.8e-3}, {2.4852e-2, 5.4e-3}}
+               : PaperRow{{3.2606e-2, 1.7e-3}, {3.5273e-2, 1.8e-3}, {4.1519e-2, 9.6e-3}};
   }
 
  private:

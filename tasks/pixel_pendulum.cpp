@@ -29,8 +29,8 @@ PixelConfig pixel_config(const RunSettings& s) {
   try {
     c = PixelConfig::from_json(j);
   } catch (const nlohmann::json::exception& e) {
-    throw Error(fmt::format("pixel-pendulum: bad task settings {}: {}", s.task_settings.dump(),
-                            e.what()));
+    throw Error(
+        fmt::format("pixel-pendulum: bad task settings {}: {}", s.task_settings.dump(), e.what()));
   }
   c.steps = s.train.steps;
   c.batch_size = s.train.batch_size;
@@ -45,7 +45,8 @@ PixelConfig pixel_config(const RunSettings& s) {
 class PixelRun : public TaskRun {
  public:
   explicit PixelRun(RunSettings settings)
-      : s_(std::move(settings)), config_(pixel_config(s_)),
+      : s_(std::move(settings)),
+        config_(pixel_config(s_)),
         data_(pixel::build_pixel_data(config_, s_.seed)) {}
 
   TrainResult train(const LoopOptions& loop) override {
@@ -77,11 +78,15 @@ class PixelRun : public TaskRun {
   }
 
   std::string rollout_csv(const RolloutRequest& r) const override {
-    HNN_TASKS_CHECK(!r.t_end, "pixel-pendulum rollouts are counted in frames: give --points "
-                              "(frames + 1), not --t-end");
+    HNN_TASKS_CHECK(!r.t_end,
+                    "pixel-pendulum rollouts are counted in frames: give --points "
+                    "(frames + 1), not --t-end");
     return pixel::pixel_rollout_csv(model(), data_, nn::to_string(s_.model),
-                                    {.integrator = r.integrator, .dt = r.dt, .rtol = r.rtol,
-                                     .frames = r.points - 1, .trajectories = r.trajectories});
+                                    {.integrator = r.integrator,
+                                     .dt = r.dt,
+                                     .rtol = r.rtol,
+                                     .frames = r.points - 1,
+                                     .trajectories = r.trajectories});
   }
 
   const nn::DynamicsModel<double>& dynamics() const override { return model().dynamics(); }

@@ -45,8 +45,9 @@ class RealPendulumTask : public FieldTask {
     return states;
   }
   PaperRow paper(nn::ModelKind model) const override {
-    return model == nn::ModelKind::kHnn ? PaperRow{{9.2376e-3, 5.0e-4}, {5.9584e-3, 6.2e-4}, {1.4477e-2, 4.7e-3}}
-                          : PaperRow{{2.7455e-3, 2.1e-4}, {2.1864e-3, 3.3e-4}, {3.8564e-1, 6.9e-2}};
+    return model == nn::ModelKind::kHnn
+               ? PaperRow{{9.2376e-3, 5.0e-4}, {5.9584e-3, 6.2e-4}, {1.4477e-2, 4.7e-3}}
+               : PaperRow{{2.7455e-3, 2.1e-4}, {2.1864e-3, 3.3e-4}, {3.8564e-1, 6.9e-2}};
   }
   bool reads_data_file() const override { return true; }
 

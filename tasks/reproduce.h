@@ -17,8 +17,8 @@ struct ReproduceOptions {
   int seeds = 1;                   // seeds 0 .. seeds-1, averaged
   Dtype dtype = Dtype::kDouble;
   Preset preset = Preset::kPaper;  // each task's widths, see Task::lean_hidden
-  int jobs = 2;                  // runs trained at once (sharing the cores)
-  std::optional<int> steps;      // override every task's step count (quick looks)
+  int jobs = 2;                    // runs trained at once (sharing the cores)
+  std::optional<int> steps;        // override every task's step count (quick looks)
   std::filesystem::path out = "results";
   bool quiet = false;
   bool reversibility = true;  // also write reversibility.md/.json over every run

@@ -83,7 +83,8 @@ json evaluate_run(const fs::path& run_dir, const std::string& data_file, bool wr
   return metrics;
 }
 
-fs::path write_rollout(const fs::path& run_dir, const RolloutRequest& request, const fs::path& out) {
+fs::path write_rollout(const fs::path& run_dir, const RolloutRequest& request,
+                       const fs::path& out) {
   const LoadedRun loaded = load_run(run_dir);
   const fs::path path =
       out.empty() ? run_dir / fmt::format("rollout_{}.csv", request.integrator) : out;
@@ -96,8 +97,8 @@ json reversibility(const fs::path& run_dir, const ReversibilityOptions& options)
   const LoadedRun loaded = load_run(run_dir);
   ReversibilityOptions o = options;
   if (o.t_end <= 0) o.t_end = loaded.run->rollout_span();
-  json result = measure_reversibility(loaded.run->dynamics(),
-                                      loaded.run->rollout_states(o.trajectories), o);
+  json result =
+      measure_reversibility(loaded.run->dynamics(), loaded.run->rollout_states(o.trajectories), o);
   result.update({{"task", loaded.settings.task},
                  {"model", nn::to_string(loaded.settings.model)},
                  {"space", loaded.run->space()}});
@@ -121,8 +122,7 @@ void check_no_unfinished_run(const fs::path& run_dir) {
   HNN_TASKS_CHECK(state.step >= state.total_steps,
                   "'{}' holds an unfinished run (step {} of {}): continue it with `hnn train "
                   "--resume {}`, or choose another --out, or delete '{}'",
-                  run_dir.string(), state.step, state.total_steps, run_dir.string(),
-                  dir.string());
+                  run_dir.string(), state.step, state.total_steps, run_dir.string(), dir.string());
 }
 
 }  // namespace hnn::tasks

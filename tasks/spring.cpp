@@ -21,15 +21,17 @@ class SpringTask : public FieldTask {
   // The `lean` preset (docs/speed_accuracy.md, chart 4): within the noise of 200-200.
   std::vector<int> lean_hidden() const override { return {16, 16}; }
   Dataset build_dataset(const RunSettings& settings) const override {
-    return oscillator_dataset(spring_, settings.seed, {.trajectories = 50, .points = 30, .t_end = 3.0});
+    return oscillator_dataset(spring_, settings.seed,
+                              {.trajectories = 50, .points = 30, .t_end = 3.0});
   }
   const physics::System& truth() const override { return spring_; }
   Batch rollout_states(const Dataset&, std::mt19937_64& rng) const override {
     return physics::sample_evaluation_states(rollout_config().trajectories, rng);
   }
   PaperRow paper(nn::ModelKind model) const override {
-    return model == nn::ModelKind::kHnn ? PaperRow{{3.6933e-2, 1.9e-3}, {3.5928e-2, 1.8e-3}, {3.8416e-4, 6.5e-5}}
-                          : PaperRow{{3.7134e-2, 1.9e-3}, {3.6656e-2, 1.9e-3}, {1.7077e-1, 2.1e-2}};
+    return model == nn::ModelKind::kHnn
+               ? PaperRow{{3.6933e-2, 1.9e-3}, {3.5928e-2, 1.8e-3}, {3.8416e-4, 6.5e-5}}
+               : PaperRow{{3.7134e-2, 1.9e-3}, {3.6656e-2, 1.9e-3}, {1.7077e-1, 2.1e-2}};
   }
 
  private:

@@ -13,9 +13,12 @@ using Factory = std::unique_ptr<Task> (*)();
 
 const std::vector<std::pair<std::string, Factory>>& registry() {
   static const std::vector<std::pair<std::string, Factory>> tasks = {
-      {"spring", make_spring_task},       {"pendulum", make_pendulum_task},
-      {"real-pendulum", make_real_pendulum_task}, {"two-body", make_two_body_task},
-      {"three-body", make_three_body_task}, {"pixel-pendulum", make_pixel_pendulum_task}};
+      {"spring", make_spring_task},
+      {"pendulum", make_pendulum_task},
+      {"real-pendulum", make_real_pendulum_task},
+      {"two-body", make_two_body_task},
+      {"three-body", make_three_body_task},
+      {"pixel-pendulum", make_pixel_pendulum_task}};
   return tasks;
 }
 

@@ -87,7 +87,8 @@ tasks::RunOptions resumed_options(const CLI::App& cmd, const std::string& dir, b
 void add_train_command(CLI::App& app) {
   auto* cmd = app.add_subcommand("train", "Train and evaluate one model on a task");
   auto options = std::make_shared<tasks::RunOptions>();
-  auto model = std::make_shared<std::string>("hnn"), dtype = std::make_shared<std::string>("double");
+  auto model = std::make_shared<std::string>("hnn"),
+       dtype = std::make_shared<std::string>("double");
   auto preset = std::make_shared<std::string>("paper");
   auto steps = std::make_shared<int>(0), batch = std::make_shared<int>(-1);
   auto lr = std::make_shared<double>(0);
@@ -168,7 +169,8 @@ void add_evaluate_command(CLI::App& app) {
 void add_reproduce_command(CLI::App& app) {
   auto* cmd = app.add_subcommand("reproduce", "Train baseline and HNN on every task: Table 1");
   auto options = std::make_shared<tasks::ReproduceOptions>();
-  auto dtype = std::make_shared<std::string>("double"), preset = std::make_shared<std::string>("paper");
+  auto dtype = std::make_shared<std::string>("double"),
+       preset = std::make_shared<std::string>("paper");
   auto steps = std::make_shared<int>(0);
   cmd->add_option("--tasks", options->tasks, "Comma-separated tasks (default: all)")
       ->delimiter(',');

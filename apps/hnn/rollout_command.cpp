@@ -24,7 +24,8 @@ void add_rollout_command(CLI::App& app) {
   cmd->add_option("run", o->run, "Run folder written by `hnn train`")
       ->required()
       ->check(CLI::ExistingDirectory);
-  cmd->add_option("--integrator", o->request.integrator, "euler, rk4, dopri5, leapfrog, yoshida4, midpoint")
+  cmd->add_option("--integrator", o->request.integrator,
+                  "euler, rk4, dopri5, leapfrog, yoshida4, midpoint")
       ->capture_default_str();
   cmd->add_option("--dt", o->request.dt, "Step of fixed-step integrators")
       ->check(positive_real())

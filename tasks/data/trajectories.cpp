@@ -10,11 +10,10 @@ namespace {
 constexpr Eigen::Index kChunk = 50;
 }  // namespace
 
-TrajectorySamples sample_trajectories(const physics::System& system, const Batch& x0,
-                                      double t_end, int points, double rtol) {
+TrajectorySamples sample_trajectories(const physics::System& system, const Batch& x0, double t_end,
+                                      int points, double rtol) {
   const std::vector<double> times = physics::linspace(0.0, t_end, points);
-  const auto integrator =
-      physics::make_integrator("dopri5", {.rtol = rtol, .atol = rtol * 1e-3});
+  const auto integrator = physics::make_integrator("dopri5", {.rtol = rtol, .atol = rtol * 1e-3});
   TrajectorySamples out;
   out.x.resize(x0.rows() * points, x0.cols());
   for (Eigen::Index start = 0; start < x0.rows(); start += kChunk) {

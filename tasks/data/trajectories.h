@@ -16,8 +16,8 @@ struct TrajectorySamples {
 
 /// Integrates every row of x0 over [0, t_end] (closed form when the system has one, else the
 /// adaptive integrator at rtol) and samples `points` evenly spaced times including both ends.
-TrajectorySamples sample_trajectories(const physics::System& system, const Batch& x0,
-                                      double t_end, int points, double rtol);
+TrajectorySamples sample_trajectories(const physics::System& system, const Batch& x0, double t_end,
+                                      int points, double rtol);
 
 /// Adds Gaussian noise of standard deviation `std` to every entry.
 void add_noise(Batch& x, double std, std::mt19937_64& rng);

@@ -7,7 +7,6 @@
 
 namespace hnn::tasks::pixel {
 
-
 /// Figure 5: from an encoded test pair, integrate the symplectic gradient S_H for `before`
 /// frames, then the Riemann gradient R_H = (dH/dq, dH/dp) (or -R_H to lower H), then S_H for
 /// `after` frames. The learned H grows along R_H at the rate |grad H|^2, which varies a lot over

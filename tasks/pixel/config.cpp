@@ -6,7 +6,6 @@
 
 namespace hnn::tasks::pixel {
 
-
 nlohmann::json PixelConfig::to_json() const {
   return {{"trials", trials},
           {"frames_per_trial", frames_per_trial},

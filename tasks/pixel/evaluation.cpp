@@ -156,9 +156,9 @@ std::string pixel_rollout_csv(const PixelModel<double>& model, const PixelData& 
     for (Eigen::Index k = 0; k + 1 < z.rows(); ++k) {
       const Eigen::RowVector2d x = state_from_frames(scene, pairs.row(k).head(kFramePixels),
                                                      pairs.row(k + 1).head(kFramePixels));
-      csv += fmt::format("{},{},{},{:.9g},{:.9g},{},{},{},{}\n", model_name, i,
-                         t[std::size_t(k)], z(k, 0), z(k, 1), cell(x(0)), cell(x(1)),
-                         cell(scene.energy(x)), h.size() ? cell(h(k)) : "");
+      csv += fmt::format("{},{},{},{:.9g},{:.9g},{},{},{},{}\n", model_name, i, t[std::size_t(k)],
+                         z(k, 0), z(k, 1), cell(x(0)), cell(x(1)), cell(scene.energy(x)),
+                         h.size() ? cell(h(k)) : "");
     }
   }
   return csv;

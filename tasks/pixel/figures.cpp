@@ -17,13 +17,11 @@ namespace fs = std::filesystem;
 
 namespace {
 
-
 constexpr int kSide = physics::GymPendulum::kSide;
 constexpr int kGap = 2;       // pixels between tiles
 constexpr int kGifScale = 3;  // each frame pixel as a 3 x 3 block in the GIF
 constexpr int kStripScale = 2;
 constexpr int kGifDelay = 5;  // hundredths of a second: Gym's dt, so the GIF runs in real time
-
 
 std::string cell(double v) { return std::isfinite(v) ? fmt::format("{:.9g}", v) : ""; }
 

@@ -26,7 +26,6 @@ double frame_angle(const physics::GymPendulum& scene, const Eigen::RowVectorXd& 
 
 }  // namespace
 
-
 Eigen::Index PixelData::first_frame(Eigen::Index row) const {
   const Eigen::Index per = pairs_per_trial();
   return (row / per) * frames_per_trial + row % per + 1;

@@ -28,7 +28,6 @@ std::vector<Eigen::Index> range(Eigen::Index start, Eigen::Index count) {
 
 }  // namespace
 
-
 namespace {
 
 nn::DynamicsConfig latent_config(const PixelConfig& config, nn::ModelKind kind) {
@@ -99,7 +98,6 @@ void PixelModel<T>::visit_parameters(const nn::ParameterVisitor<T>& visit) {
 
 template class PixelModel<float>;
 template class PixelModel<double>;
-
 
 template <typename T>
 PixelLoss<T> pixel_loss(const PixelModel<T>& model, const ad::Var<T>& x, const ad::Var<T>& x_next,

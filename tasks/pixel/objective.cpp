@@ -34,8 +34,6 @@ double mean_loss(const PixelModel<T>& model, const PixelData& data, Eigen::Index
   return total / double(count);
 }
 
-
-
 Eigen::Index batch_rows(const PixelConfig& config, const PixelData& data) {
   const Eigen::Index n = data.train_rows();
   return config.batch_size == 0 ? n : std::min<Eigen::Index>(config.batch_size, n);
@@ -57,7 +55,8 @@ PixelObjective<T>::PixelObjective(PixelModel<T>& model, const PixelData& data,
 // PixelConfig::dynamics_weight_decay).
 template <typename T>
 std::vector<ParameterGroup<T>> PixelObjective<T>::parameter_groups() const {
-  ParameterGroup<T> autoencoder{{}, {.lr = config_.learning_rate, .weight_decay = config_.weight_decay}};
+  ParameterGroup<T> autoencoder{
+      {}, {.lr = config_.learning_rate, .weight_decay = config_.weight_decay}};
   ParameterGroup<T> dynamics{
       {}, {.lr = config_.learning_rate, .weight_decay = config_.dynamics_weight_decay}};
   for (const nn::NamedParameter<T>& p : model_.named_parameters())

@@ -29,9 +29,10 @@ std::string integrator_cell(const json& row, const char* name) {
 }
 
 std::string table_line(const json& row) {
-  std::string line = fmt::format("| {} | {} |", row["task"].get<std::string>(),
-                                 row["model"].get<std::string>());
-  for (const char* name : {"midpoint", "rk4", "dopri5"}) line += " " + integrator_cell(row, name) + " |";
+  std::string line =
+      fmt::format("| {} | {} |", row["task"].get<std::string>(), row["model"].get<std::string>());
+  for (const char* name : {"midpoint", "rk4", "dopri5"})
+    line += " " + integrator_cell(row, name) + " |";
   const json& v = row["volume"];
   line += v.contains("det_mean") && v["det_mean"].is_number()
               ? fmt::format(" {:.4g} |\n", v["det_mean"].get<double>())
@@ -44,7 +45,8 @@ std::string failure_lines(const json& row) {
       fmt::format("{} {}", row["task"].get<std::string>(), row["model"].get<std::string>());
   std::string lines;
   for (const json& i : row["integrators"]) {
-    if (i.contains("failure")) lines += fmt::format("- {}: {}\n", who, i["failure"].get<std::string>());
+    if (i.contains("failure"))
+      lines += fmt::format("- {}: {}\n", who, i["failure"].get<std::string>());
   }
   if (row["volume"].contains("failure"))
     lines += fmt::format("- {}, det: {}\n", who, row["volume"]["failure"].get<std::string>());

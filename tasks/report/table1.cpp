@@ -26,7 +26,6 @@ std::string widths_note(const json& row) {
 
 }  // namespace
 
-
 std::string table1_markdown(const json& rows, double wall_seconds,
                             const std::vector<std::string>& notes) {
   std::map<std::string, std::map<std::string, json>> by_task;

@@ -1,7 +1,8 @@
 #pragma once
 // Training checkpoints: everything a run needs to continue exactly where it stopped (model
-// parameters, the step count and moments of each parameter group's Adam, the minibatch generator's state, the loss curve so
-// far), kept in RUN/checkpoint/ so that a kill at any moment leaves one complete checkpoint.
+// parameters, the step count and moments of each parameter group's Adam, the minibatch generator's
+// state, the loss curve so far), kept in RUN/checkpoint/ so that a kill at any moment leaves one
+// complete checkpoint.
 //
 // Note [Checkpoint commit]: a checkpoint is two files, each written atomically. First
 // step-<N>.bin (the parameters and Adam's moments in nn's checksummed parameter format), then
@@ -11,8 +12,8 @@
 
 #include <cstdint>
 #include <filesystem>
-#include <span>
 #include <nlohmann/json.hpp>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -43,8 +44,9 @@ void save_train_checkpoint(const std::filesystem::path& dir, const nn::Module<T>
 TrainState read_train_state(const std::filesystem::path& dir);
 
 /// Loads the matrices of the checkpoint `state` (from read_train_state) into `model` and the
-/// optimisers `adams` (one per parameter group, whose parameters list the model's in order). Everything is checked first: on any mismatch (kind, scalar type, names, shapes, a
-/// truncated or corrupt file) it throws and changes nothing.
+/// optimisers `adams` (one per parameter group, whose parameters list the model's in order).
+/// Everything is checked first: on any mismatch (kind, scalar type, names, shapes, a truncated or
+/// corrupt file) it throws and changes nothing.
 template <typename T>
 void load_train_checkpoint(const std::filesystem::path& dir, const TrainState& state,
                            nn::Module<T>& model, std::span<nn::Adam<T>> adams);

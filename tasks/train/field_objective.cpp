@@ -50,9 +50,9 @@ CurvePoint FieldObjective<T>::curve_point(long step, double batch_loss) const {
   const Eigen::Index train = std::min(kCurveRows, data_.train_x.rows());
   const Eigen::Index test = std::min(kCurveRows, data_.test_x.rows());
   return {step,
-          sampler_.full() ? batch_loss
-                          : field_mse(model_, data_.train_x.topRows(train),
-                                      data_.train_dxdt.topRows(train)),
+          sampler_.full()
+              ? batch_loss
+              : field_mse(model_, data_.train_x.topRows(train), data_.train_dxdt.topRows(train)),
           test > 0 ? field_mse(model_, data_.test_x.topRows(test), data_.test_dxdt.topRows(test))
                    : NAN};
 }

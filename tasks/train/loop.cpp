@@ -26,6 +26,7 @@ class GroupedAdam {
   explicit GroupedAdam(const std::vector<ParameterGroup<T>>& groups) {
     adams_.reserve(groups.size());  // no reallocation: the Adams stay where they are built
     for (const ParameterGroup<T>& group : groups) {
+      check(group.adam);
       adams_.emplace_back(group.parameters, group.adam);
       slices_.emplace_back().reserve(group.parameters.size());
       all_.insert(all_.end(), group.parameters.begin(), group.parameters.end());
@@ -33,6 +34,13 @@ class GroupedAdam {
   }
   const std::vector<ad::Var<T>>& parameters() const { return all_; }
   std::vector<nn::Adam<T>>& adams() { return adams_; }
+
+  static void check(const nn::AdamOptions& o) {
+    HNN_TASKS_CHECK(o.lr > 0 && std::isfinite(o.lr), "learning rate must be positive, got {}",
+                    o.lr);
+    HNN_TASKS_CHECK(o.weight_decay >= 0 && std::isfinite(o.weight_decay),
+                    "weight decay must be a finite number >= 0, got {}", o.weight_decay);
+  }
 
   void step(const std::vector<ad::Var<T>>& grads) {
     auto first = grads.begin();
@@ -58,8 +66,9 @@ void check_groups(Objective<T>& objective, const std::vector<ad::Var<T>>& groupe
   bool same = params.size() == grouped.size();
   for (std::size_t i = 0; same && i < params.size(); ++i)
     same = &params[i].value() == &grouped[i].value();
-  HNN_TASKS_CHECK(same, "the objective's parameter groups do not list the model's parameters in "
-                        "order");
+  HNN_TASKS_CHECK(same,
+                  "the objective's parameter groups do not list the model's parameters in "
+                  "order");
 }
 
 // The checkpoints of one run (LoopOptions::checkpoint_dir): when they are due, writing them and
@@ -68,7 +77,8 @@ template <typename T>
 class Checkpoints {
  public:
   Checkpoints(const LoopOptions& o, std::uint64_t data_hash)
-      : o_(o), every_(o.checkpoint_every > 0 ? o.checkpoint_every : std::max(1L, o.steps / 10)),
+      : o_(o),
+        every_(o.checkpoint_every > 0 ? o.checkpoint_every : std::max(1L, o.steps / 10)),
         data_hash_(data_hash) {}
 
   bool enabled() const { return !o_.checkpoint_dir.empty(); }

@@ -44,10 +44,9 @@ void Progress::print(long done, double loss, bool final) {
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
   const double rate = seconds > 0 ? double(done) / seconds : 0.0;
   const double left = rate > 0 ? double(total_ - done) / rate : 0.0;
-  const std::string stats = fmt::format("{}/{} steps  loss {:.4e}  {:.0f} steps/s  {}", done,
-                                        total_, loss, rate,
-                                        final ? fmt::format("{:.1f} s", seconds)
-                                              : fmt::format("{:.0f} s left", left));
+  const std::string stats =
+      fmt::format("{}/{} steps  loss {:.4e}  {:.0f} steps/s  {}", done, total_, loss, rate,
+                  final ? fmt::format("{:.1f} s", seconds) : fmt::format("{:.0f} s left", left));
   if (terminal_) {
     constexpr int kWidth = 24;
     const int filled = int(kWidth * done / total_);

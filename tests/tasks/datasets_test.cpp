@@ -9,7 +9,7 @@
 #include <sstream>
 
 #include "physics/integrator.h"
-#include "tasks/task.h"
+#include "tasks/field_task.h"
 #include "tests/tasks/test_configs.h"
 
 namespace hnn::tasks {
@@ -64,6 +64,7 @@ TEST(TaskRegistry, NamesTheStateTasksInOrderAndRejectsOthers) {
     EXPECT_EQ(task->name(), name);
     EXPECT_FALSE(task->summary().empty());
   }
+  EXPECT_THROW(make_field_task("pixel-pendulum"), Error);  // it learns from frames
   try {
     make_task("spring2");
     FAIL() << "an unknown task was accepted";
@@ -84,7 +85,7 @@ TEST(TaskRegistry, TrainingSettingsAreThePapers) {
        {Expected{"spring", 2000, 0, 1e-4, 100}, Expected{"pendulum", 2000, 0, 1e-4, 100},
         Expected{"real-pendulum", 2000, 0, 1e-5, 100}, Expected{"two-body", 10000, 200, 0.0, 1000},
         Expected{"three-body", 10000, 600, 1e-4, 100}}) {
-    const std::unique_ptr<Task> task = make_task(e.task);
+    const std::unique_ptr<FieldTask> task = make_field_task(e.task);
     const TrainConfig c = task->train_config();
     EXPECT_EQ(c.steps, e.steps) << e.task;
     EXPECT_EQ(c.batch_size, e.batch) << e.task;
@@ -96,26 +97,31 @@ TEST(TaskRegistry, TrainingSettingsAreThePapers) {
     EXPECT_EQ(r.trajectories, 15) << e.task;
     EXPECT_DOUBLE_EQ(r.t_end, 20.0) << e.task;
     EXPECT_LE(r.rtol, 1e-9) << e.task;
-    for (const char* model : {"baseline", "hnn"}) {
+    for (const nn::ModelKind model : {nn::ModelKind::kBaseline, nn::ModelKind::kHnn}) {
       const PaperRow p = task->paper(model);
       EXPECT_GT(p.train_loss.mean, 0) << e.task;
       EXPECT_GT(p.test_loss.mean, 0) << e.task;
       EXPECT_GT(p.energy_mse.mean, 0) << e.task;
     }
     // The paper's HNN conserves energy better than its baseline on every task.
-    EXPECT_LT(task->paper("hnn").energy_mse.mean, task->paper("baseline").energy_mse.mean);
+    EXPECT_LT(task->paper(nn::ModelKind::kHnn).energy_mse.mean,
+              task->paper(nn::ModelKind::kBaseline).energy_mse.mean);
   }
 }
 
 TEST(TaskRegistry, OnlyMeasuredDataTasksTakeADataFile) {
-  EXPECT_THROW(make_task("spring")->set_data_file("x.txt"), std::exception);
-  EXPECT_THROW(make_task("two-body")->set_data_file("x.txt"), std::exception);
-  EXPECT_NO_THROW(make_task("real-pendulum")->set_data_file("x.txt"));
+  for (const char* name : {"spring", "two-body", "pixel-pendulum"}) {
+    EXPECT_FALSE(make_task(name)->reads_data_file()) << name;
+    EXPECT_THROW(resolve(*make_task(name), {.task = name, .data_file = "x.txt"}), Error) << name;
+  }
+  EXPECT_TRUE(make_task("real-pendulum")->reads_data_file());
+  EXPECT_NO_THROW(
+      resolve(*make_task("real-pendulum"), {.task = "real-pendulum", .data_file = "x.txt"}));
 }
 
 // Task 1: H = q^2 + p^2, 50 trajectories of 30 points over [0, 3], noise std 0.1.
 TEST(SpringDataset, SplitsTrajectoriesInHalves) {
-  const Dataset d = make_task("spring")->build_dataset(0);
+  const Dataset d = make_field_task("spring")->build_dataset(0);
   EXPECT_EQ(d.train_x.rows(), 750);
   EXPECT_EQ(d.test_x.rows(), 750);
   for (const Batch* b : {&d.train_x, &d.train_dxdt, &d.test_x, &d.test_dxdt})
@@ -125,7 +131,7 @@ TEST(SpringDataset, SplitsTrajectoriesInHalves) {
 }
 
 TEST(SpringDataset, TargetsAreTheExactFieldOnCleanOrbitsAndInputsCarryNoise) {
-  const Dataset d = make_task("spring")->build_dataset(3);
+  const Dataset d = make_field_task("spring")->build_dataset(3);
   const Batch x = stack(d.train_x, d.test_x), dxdt = stack(d.train_dxdt, d.test_dxdt);
   // dq/dt = 2p, dp/dt = -2q at the clean state, so the targets give the clean state back.
   Batch clean(x.rows(), 2);
@@ -155,8 +161,8 @@ TEST(SpringDataset, TargetsAreTheExactFieldOnCleanOrbitsAndInputsCarryNoise) {
 }
 
 TEST(SpringDataset, SameSeedSameBitsOtherSeedOtherData) {
-  const std::unique_ptr<Task> task = make_task("spring");
-  const Dataset a = task->build_dataset(11), b = make_task("spring")->build_dataset(11);
+  const std::unique_ptr<FieldTask> task = make_field_task("spring");
+  const Dataset a = task->build_dataset(11), b = make_field_task("spring")->build_dataset(11);
   EXPECT_TRUE(bit_identical(a, b));
   const Dataset c = task->build_dataset(12);
   EXPECT_FALSE(bit_identical(a.train_x, c.train_x));
@@ -165,7 +171,7 @@ TEST(SpringDataset, SameSeedSameBitsOtherSeedOtherData) {
 
 // Task 2: H = 3(1 - cos q) + p^2, radius U[1.3, 2.3], 45 points over [0, 3].
 TEST(PendulumDataset, SplitsTrajectoriesInHalves) {
-  const Dataset d = make_task("pendulum")->build_dataset(0);
+  const Dataset d = make_field_task("pendulum")->build_dataset(0);
   EXPECT_EQ(d.train_x.rows(), 1125);
   EXPECT_EQ(d.test_x.rows(), 1125);
   EXPECT_EQ(d.train_dxdt.rows(), 1125);
@@ -175,7 +181,7 @@ TEST(PendulumDataset, SplitsTrajectoriesInHalves) {
 }
 
 TEST(PendulumDataset, TargetsAreTheExactFieldOnCleanOrbitsAndInputsCarryNoise) {
-  const std::unique_ptr<Task> task = make_task("pendulum");
+  const std::unique_ptr<FieldTask> task = make_field_task("pendulum");
   const Dataset d = task->build_dataset(5);
   const Batch x = stack(d.train_x, d.test_x), dxdt = stack(d.train_dxdt, d.test_dxdt);
   // dq/dt = 2p and dp/dt = -3 sin q give p and sin q; the branch of q (cos q > 0 or < 0) is the
@@ -235,10 +241,10 @@ TEST(PendulumDataset, TargetsAreTheExactFieldOnCleanOrbitsAndInputsCarryNoise) {
 }
 
 TEST(PendulumDataset, SameSeedSameBitsOtherSeedOtherData) {
-  const Dataset a = make_task("pendulum")->build_dataset(2);
-  const Dataset b = make_task("pendulum")->build_dataset(2);
+  const Dataset a = make_field_task("pendulum")->build_dataset(2);
+  const Dataset b = make_field_task("pendulum")->build_dataset(2);
   EXPECT_TRUE(bit_identical(a, b));
-  EXPECT_FALSE(bit_identical(a.train_x, make_task("pendulum")->build_dataset(3).train_x));
+  EXPECT_FALSE(bit_identical(a.train_x, make_field_task("pendulum")->build_dataset(3).train_x));
 }
 
 // Task 3: the shipped Schmidt & Lipson file, read here independently of physics/lipson.
@@ -267,7 +273,7 @@ TEST(RealPendulumDataset, ForwardDifferencesOfTheShippedFileSplit80To20InOrder) 
   const MeasuredRows file =
       read_measured(std::filesystem::path(HNN_SOURCE_DIR) / "data/lipson/real_pend_h_1.txt");
   ASSERT_EQ(file.t.size(), 556u);  // one trial
-  const Dataset d = make_task("real-pendulum")->build_dataset(0);
+  const Dataset d = make_field_task("real-pendulum")->build_dataset(0);
   const Eigen::Index n = 555, cut = n * 8 / 10;  // the last point has no forward difference
   ASSERT_EQ(d.train_x.rows(), cut);
   ASSERT_EQ(d.test_x.rows(), n - cut);
@@ -285,7 +291,7 @@ TEST(RealPendulumDataset, ForwardDifferencesOfTheShippedFileSplit80To20InOrder) 
 }
 
 TEST(RealPendulumDataset, IgnoresTheSeed) {
-  const std::unique_ptr<Task> task = make_task("real-pendulum");
+  const std::unique_ptr<FieldTask> task = make_field_task("real-pendulum");
   EXPECT_TRUE(bit_identical(task->build_dataset(0), task->build_dataset(9)));
 }
 
@@ -302,9 +308,8 @@ TEST(RealPendulumDataset, ReadsAnotherFileAndDifferencesWithinEachTrial) {
         out << trial << " " << t << " " << t * t << " " << trial + k << "\r\n";
       }
   }
-  const std::unique_ptr<Task> task = make_task("real-pendulum");
-  task->set_data_file(path.string());
-  const Dataset d = task->build_dataset(0);
+  const std::unique_ptr<FieldTask> task = make_field_task("real-pendulum");
+  const Dataset d = task->build_dataset({.task = "real-pendulum", .data_file = path.string()});
   // 7 + 5 differences (none across the trial boundary): 9 train, 3 test.
   ASSERT_EQ(d.train_x.rows(), 9);
   ASSERT_EQ(d.test_x.rows(), 3);
@@ -320,13 +325,11 @@ TEST(RealPendulumDataset, ReadsAnotherFileAndDifferencesWithinEachTrial) {
 
 TEST(RealPendulumDataset, MissingOrMalformedFileThrows) {
   testing::TempDir dir("data");
-  const std::unique_ptr<Task> task = make_task("real-pendulum");
-  task->set_data_file((dir / "absent.txt").string());
-  EXPECT_THROW(task->build_dataset(0), std::exception);
+  const std::unique_ptr<FieldTask> task = make_field_task("real-pendulum");
+  EXPECT_THROW(task->build_dataset({.data_file = (dir / "absent.txt").string()}), std::exception);
   const std::filesystem::path backwards = dir / "backwards.txt";
   std::ofstream(backwards) << "%o v\n0 1.0 0.1 0.2\n0 0.5 0.2 0.3\n0 1.5 0.3 0.4\n";
-  task->set_data_file(backwards.string());
-  EXPECT_THROW(task->build_dataset(0), std::exception);
+  EXPECT_THROW(task->build_dataset({.data_file = backwards.string()}), std::exception);
 }
 
 // Tasks 4 and 4b: gravity, masses 1, G = 1, coordinates (qx.., qy.., px.., py..).
@@ -365,7 +368,7 @@ void expect_zero_com_and_momentum(const Batch& x, int n, const std::string& what
 
 // Checks trajectories of an N-body split: exact targets, conserved energy, and (for a few) the
 // sample times against an independent tight integration.
-void expect_exact_trajectories(const Task& task, const Batch& x, const Batch& dxdt, int n,
+void expect_exact_trajectories(const FieldTask& task, const Batch& x, const Batch& dxdt, int n,
                                int points, double t_end, const std::string& what) {
   const int trajectories = int(x.rows()) / points;
   const Batch field = nbody_field(x, n);
@@ -388,7 +391,7 @@ void expect_exact_trajectories(const Task& task, const Batch& x, const Batch& dx
 }
 
 TEST(TwoBodyDataset, TwentyPercentTestFirstExactDerivativesNearCircularOrbits) {
-  const std::unique_ptr<Task> task = make_task("two-body");
+  const std::unique_ptr<FieldTask> task = make_field_task("two-body");
   const Dataset d = task->build_dataset(0);
   ASSERT_EQ(d.train_x.rows(), 40000);
   ASSERT_EQ(d.test_x.rows(), 10000);
@@ -416,15 +419,17 @@ TEST(TwoBodyDataset, TwentyPercentTestFirstExactDerivativesNearCircularOrbits) {
 }
 
 TEST(TwoBodyDataset, SameSeedSameBitsOtherSeedOtherData) {
-  const Dataset a = make_task("two-body")->build_dataset(4);
-  EXPECT_TRUE(bit_identical(a, make_task("two-body")->build_dataset(4)));
-  EXPECT_FALSE(bit_identical(a.test_x, make_task("two-body")->build_dataset(5).test_x));
+  const Dataset a = make_field_task("two-body")->build_dataset(4);
+  EXPECT_TRUE(bit_identical(a, make_field_task("two-body")->build_dataset(4)));
+  EXPECT_FALSE(bit_identical(a.test_x, make_field_task("two-body")->build_dataset(5).test_x));
 }
 
 // The three-body set (100,000 points) is built once for all its tests.
 class ThreeBodyDataset : public ::testing::Test {
  protected:
-  static void SetUpTestSuite() { data_ = new Dataset(make_task("three-body")->build_dataset(0)); }
+  static void SetUpTestSuite() {
+    data_ = new Dataset(make_field_task("three-body")->build_dataset(0));
+  }
   static void TearDownTestSuite() {
     delete data_;
     data_ = nullptr;
@@ -440,7 +445,7 @@ TEST_F(ThreeBodyDataset, TwentyPercentTestFirstExactDerivatives) {
   ASSERT_EQ(d.train_dxdt.rows(), 80000);
   ASSERT_EQ(d.test_dxdt.rows(), 20000);
   ASSERT_EQ(d.train_x.cols(), 12);
-  const std::unique_ptr<Task> task = make_task("three-body");
+  const std::unique_ptr<FieldTask> task = make_field_task("three-body");
   expect_exact_trajectories(*task, d.train_x, d.train_dxdt, 3, 20, 5.0, "train");
   expect_exact_trajectories(*task, d.test_x, d.test_dxdt, 3, 20, 5.0, "test");
 }
@@ -484,7 +489,7 @@ TEST_F(ThreeBodyDataset, InitialStatesArePerturbedRotatingTriangles) {
 }
 
 TEST_F(ThreeBodyDataset, SameSeedSameBits) {
-  EXPECT_TRUE(bit_identical(*data_, make_task("three-body")->build_dataset(0)));
+  EXPECT_TRUE(bit_identical(*data_, make_field_task("three-body")->build_dataset(0)));
 }
 
 }  // namespace

@@ -1,8 +1,6 @@
 // The shared evaluator: losses with standard errors, rollouts of true and learned fields, the
 // energy MSE and its standard error, failures of learned rollouts, and the HNN's own H.
 
-#include "tasks/evaluate.h"
-
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -11,8 +9,9 @@
 
 #include "nn/hnn.h"
 #include "physics/integrator.h"
-#include "tasks/task.h"
-#include "tasks/trainer.h"
+#include "tasks/evaluate/rollouts.h"
+#include "tasks/field_task.h"
+#include "tasks/train/field_objective.h"
 #include "tests/tasks/test_configs.h"
 
 namespace hnn::tasks {
@@ -41,7 +40,7 @@ class FunctionModel : public nn::DynamicsModel<double> {
   Fn fn_;
 };
 
-FunctionModel exact_model(const Task& task) {
+FunctionModel exact_model(const FieldTask& task) {
   const physics::System& truth = task.truth();
   return FunctionModel(truth.dim(), [&truth](const Batch& x) {
     Batch dxdt;
@@ -62,7 +61,7 @@ std::unique_ptr<nn::DynamicsModel<double>> small_model(const std::string& kind, 
 }
 
 TEST(LossStats, MeanOverPointsAndComponentsWithTheReferencesStandardError) {
-  const std::unique_ptr<Task> task = make_task("spring");
+  const std::unique_ptr<FieldTask> task = make_field_task("spring");
   const Dataset d = task->build_dataset(0);
   const FunctionModel exact = exact_model(*task);
   const nn::MeanStderr s = loss_stats(exact, d.test_x, d.test_dxdt);
@@ -89,7 +88,7 @@ TEST(LossStats, MeanOverPointsAndComponentsWithTheReferencesStandardError) {
 TEST(LossStats, ChunkedEvaluationCoversEveryRow) {
   // More rows than one evaluation chunk (4096): a random model's loss equals the loss computed
   // in one go.
-  const std::unique_ptr<Task> task = make_task("two-body");
+  const std::unique_ptr<FieldTask> task = make_field_task("two-body");
   const Dataset d = task->build_dataset(1);
   const auto model = small_model("baseline", 8, 3);
   const Batch pred = model->field(d.train_x);
@@ -100,12 +99,12 @@ TEST(LossStats, ChunkedEvaluationCoversEveryRow) {
 }
 
 TEST(MakeRollouts, ExactModelFollowsTheTruthAndHasNoEnergyError) {
-  const std::unique_ptr<Task> task = make_task("pendulum");
+  const std::unique_ptr<FieldTask> task = make_field_task("pendulum");
   const FunctionModel exact = exact_model(*task);
   Batch x0(3, 2);
   x0 << 0.5, -0.3, -1.0, 0.8, 0.2, 0.9;
   const RolloutConfig config{.trajectories = 3, .t_end = 5.0, .points = 26};
-  const Rollouts r = make_rollouts(*task, exact, x0, config);
+  const Rollouts r = make_rollouts(task->truth(), exact, x0, config);
   ASSERT_EQ(r.t.size(), 26u);
   EXPECT_DOUBLE_EQ(r.t.front(), 0.0);
   EXPECT_DOUBLE_EQ(r.t.back(), 5.0);
@@ -136,7 +135,7 @@ TEST(MakeRollouts, ExactModelFollowsTheTruthAndHasNoEnergyError) {
 
 TEST(MakeRollouts, TrueRolloutsConserveEnergyOnEveryTask) {
   for (const std::string& name : testing::state_tasks()) {
-    const std::unique_ptr<Task> task = make_task(name);
+    const std::unique_ptr<FieldTask> task = make_field_task(name);
     const Dataset d = task->build_dataset(0);
     std::mt19937_64 rng(1);
     const Batch x0 = task->rollout_states(d, rng);
@@ -145,7 +144,7 @@ TEST(MakeRollouts, TrueRolloutsConserveEnergyOnEveryTask) {
     // A zero field stays at x0: its energy is the true energy of x0 at every time.
     const FunctionModel still = zero_model(x0.cols());
     const RolloutConfig config{.trajectories = 15, .t_end = 5.0, .points = 11};
-    const Rollouts r = make_rollouts(*task, still, x0.topRows(4), config);
+    const Rollouts r = make_rollouts(task->truth(), still, x0.topRows(4), config);
     for (int i = 0; i < 4; ++i) {
       const Eigen::RowVectorXd e = r.true_energy.row(i);
       const double scale = std::max(1.0, std::abs(e(0)));
@@ -160,7 +159,7 @@ TEST(MakeRollouts, TrueRolloutsConserveEnergyOnEveryTask) {
 TEST(MakeRollouts, OscillatorRolloutStatesArePushedAwayFromZero) {
   // Tasks 1-2: uniform in [-0.8, 0.8]^2 pushed 0.2 away from zero in each component.
   for (const char* name : {"spring", "pendulum"}) {
-    const std::unique_ptr<Task> task = make_task(name);
+    const std::unique_ptr<FieldTask> task = make_field_task(name);
     std::mt19937_64 rng(7);
     const Batch x0 = task->rollout_states(task->build_dataset(0), rng);
     EXPECT_EQ(x0.rows(), 15);
@@ -172,7 +171,7 @@ TEST(MakeRollouts, OscillatorRolloutStatesArePushedAwayFromZero) {
 }
 
 TEST(MakeRollouts, RealPendulumStartsFromMeasuredTestStates) {
-  const std::unique_ptr<Task> task = make_task("real-pendulum");
+  const std::unique_ptr<FieldTask> task = make_field_task("real-pendulum");
   const Dataset d = task->build_dataset(0);
   std::mt19937_64 rng(0);
   const Batch x0 = task->rollout_states(d, rng);
@@ -186,12 +185,12 @@ TEST(MakeRollouts, RealPendulumStartsFromMeasuredTestStates) {
 }
 
 TEST(MakeRollouts, HnnConservesItsOwnLearnedHamiltonian) {
-  const std::unique_ptr<Task> task = make_task("spring");
+  const std::unique_ptr<FieldTask> task = make_field_task("spring");
   std::mt19937_64 rng(2);
   const Batch x0 = task->rollout_states(task->build_dataset(0), rng).topRows(3);
   const RolloutConfig config{.trajectories = 3, .t_end = 10.0, .points = 21};
   const auto hnn = small_model("hnn", 2, 5);
-  const Rollouts r = make_rollouts(*task, *hnn, x0, config);
+  const Rollouts r = make_rollouts(task->truth(), *hnn, x0, config);
   ASSERT_EQ(r.learned_h.rows(), 3);
   ASSERT_EQ(r.learned_h.cols(), 21);
   const auto& h_model = dynamic_cast<const nn::Hnn<double>&>(*hnn);
@@ -202,11 +201,12 @@ TEST(MakeRollouts, HnnConservesItsOwnLearnedHamiltonian) {
     EXPECT_LT((h.array() - h(0)).abs().maxCoeff(), 1e-7) << "trajectory " << i;
   }
   // A baseline has no H of its own.
-  EXPECT_EQ(make_rollouts(*task, *small_model("baseline", 2, 5), x0, config).learned_h.size(), 0);
+  EXPECT_EQ(
+      make_rollouts(task->truth(), *small_model("baseline", 2, 5), x0, config).learned_h.size(), 0);
 }
 
 TEST(MakeRollouts, BlowUpIsRecordedAsAFailureAndLeftOutOfTheMetrics) {
-  const std::unique_ptr<Task> task = make_task("spring");
+  const std::unique_ptr<FieldTask> task = make_field_task("spring");
   // dq/dt = q^2 reaches infinity at t = 1/q0 when q0 > 0, and decays when q0 < 0.
   const FunctionModel explosive(2, [](const Batch& x) {
     Batch dxdt = Batch::Zero(x.rows(), 2);
@@ -215,7 +215,7 @@ TEST(MakeRollouts, BlowUpIsRecordedAsAFailureAndLeftOutOfTheMetrics) {
   });
   Batch x0(3, 2);
   x0 << 1.0, 0.3, -1.0, 0.3, -0.5, -0.4;
-  const Rollouts r = make_rollouts(*task, explosive, x0, {.t_end = 3.0, .points = 31});
+  const Rollouts r = make_rollouts(task->truth(), explosive, x0, {.t_end = 3.0, .points = 31});
   ASSERT_EQ(r.failed.size(), 3u);
   EXPECT_TRUE(r.failed[0]);
   EXPECT_FALSE(r.failed[1]);

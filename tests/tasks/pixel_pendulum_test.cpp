@@ -13,9 +13,11 @@
 #include "autodiff/grad.h"
 #include "autodiff/ops.h"
 #include "autodiff/tape.h"
-#include "tasks/image_io.h"
-#include "tasks/reversibility.h"
-#include "tasks/task.h"
+#include "tasks/evaluate/reversibility.h"
+#include "tasks/pixel/bump.h"
+#include "tasks/pixel/objective.h"
+#include "tasks/report/image_io.h"
+#include "tasks/run.h"
 
 namespace hnn::tasks::pixel {
 namespace {
@@ -54,10 +56,29 @@ std::string head_bytes(const fs::path& path, std::size_t n) {
   return bytes;
 }
 
-TrainHooks quiet() {
-  TrainHooks h;
-  h.quiet = true;
-  return h;
+// The training loop on the pixel objective, quiet.
+template <typename T>
+TrainResult train_pixel(PixelModel<T>& model, const PixelData& data, const PixelConfig& c,
+                        std::uint64_t seed) {
+  PixelObjective<T> objective(model, data, c, seed);
+  return train(objective, {.steps = c.steps, .record_every = c.record_every, .quiet = true});
+}
+
+// `hnn train pixel-pendulum` options for a config: the training settings as options, the rest
+// as the task's own settings.
+RunOptions run_options(const PixelConfig& c, const fs::path& out, std::uint64_t seed) {
+  RunOptions o{.task = kPixelPendulum,
+               .seed = seed,
+               .steps = c.steps,
+               .batch_size = c.batch_size,
+               .hidden = c.hidden,
+               .learning_rate = c.learning_rate,
+               .out = out,
+               .quiet = true};
+  o.task_settings = c.to_json();
+  for (const char* key : {"steps", "batch_size", "learning_rate", "weight_decay", "hidden"})
+    o.task_settings.erase(key);
+  return o;
 }
 
 // One trained HNN shared by the tests that need a model (training is the slow part).
@@ -67,7 +88,7 @@ struct Trained {
   std::mt19937_64 rng{3};
   PixelModel<double> model{config, nn::ModelKind::kHnn, rng};
   TrainResult result;
-  Trained() { result = train_pixel_model(model, data, config, 3, quiet()); }
+  Trained() { result = train_pixel(model, data, config, 3); }
 };
 
 const Trained& trained() {
@@ -239,20 +260,15 @@ TEST(PixelTraining, BaselineLossDecreasesToo) {
   const PixelData d = build_pixel_data(c, 2);
   std::mt19937_64 rng(2);
   PixelModel<float> model(c, nn::ModelKind::kBaseline, rng);
-  const TrainResult r = train_pixel_model(model, d, c, 2, quiet());
+  const TrainResult r = train_pixel(model, d, c, 2);
   EXPECT_LT(r.curve.back().train_loss, 0.5 * r.curve.front().train_loss);
 }
 
 TEST(PixelRun, WritesTheRunFolderWithReadableGifAndPng) {
   const fs::path dir = scratch("run");
-  RunOptions o;
-  o.task = kTaskName;
-  o.seed = 5;
-  o.out = dir;
-  o.quiet = true;
   PixelConfig c = small_config();
   c.steps = 20;
-  const nlohmann::json m = run_pixel_training(o, c);
+  const nlohmann::json m = run_training(run_options(c, dir, 5));
   for (const char* key : {"train_loss", "train_loss_se", "test_loss", "test_loss_se", "energy_mse",
                           "energy_mse_se", "energy_mse_within_pair", "energy_mse_frames_floor",
                           "amplitude_ratio", "n_rollouts", "train_seconds", "eval_seconds"}) {
@@ -263,7 +279,7 @@ TEST(PixelRun, WritesTheRunFolderWithReadableGifAndPng) {
   EXPECT_EQ(m["pixel"]["dynamics_weight_decay"], 0.0);
   EXPECT_EQ(m["n_rollouts"], 1);
   for (const char* file : {"metrics.json", "loss_curve.csv", "params.bin", "pixel_rollout.csv",
-                           "latent_grid.csv", "latent_paths.csv"}) {
+                           "latent_grid.csv", "latent_paths.csv", "checkpoint/state.json"}) {
     EXPECT_TRUE(fs::exists(dir / file)) << file;
   }
   EXPECT_EQ(head_bytes(dir / "rollout.gif", 6), "GIF89a");
@@ -280,7 +296,7 @@ TEST(PixelRun, WritesTheRunFolderWithReadableGifAndPng) {
   // Loaded back, the same parameters give the same losses.
   const nlohmann::json again = evaluate_run(dir, "", false);
   EXPECT_DOUBLE_EQ(again["test_loss"].get<double>(), m["test_loss"].get<double>());
-  EXPECT_TRUE(is_pixel_run(dir));
+  EXPECT_EQ(pixel_parts(*load_run(dir).run).config.trials, c.trials);
 }
 
 TEST(PixelBump, RiemannGradientRaisesTheLearnedH) {
@@ -369,13 +385,13 @@ TEST(ImageIo, PngAndGifRoundTrip) {
 }
 
 TEST(PixelTask, IsRegisteredWithThePapersRow) {
-  const std::unique_ptr<Task> task = make_task(kTaskName);
-  EXPECT_EQ(task->name(), kTaskName);
+  const std::unique_ptr<Task> task = make_task(kPixelPendulum);
+  EXPECT_EQ(task->name(), kPixelPendulum);
   EXPECT_EQ(task->train_config().steps, 10000);
   EXPECT_EQ(task->train_config().batch_size, 200);
   EXPECT_DOUBLE_EQ(task->train_config().weight_decay, 1e-5);
-  EXPECT_DOUBLE_EQ(task->paper("hnn").test_loss.mean, 1.8451e-4);
-  EXPECT_DOUBLE_EQ(task->paper("baseline").energy_mse.mean, 9.2748e-3);
+  EXPECT_DOUBLE_EQ(task->paper(nn::ModelKind::kHnn).test_loss.mean, 1.8451e-4);
+  EXPECT_DOUBLE_EQ(task->paper(nn::ModelKind::kBaseline).energy_mse.mean, 9.2748e-3);
 }
 
 }  // namespace

@@ -6,9 +6,8 @@
 
 #include <algorithm>
 
+#include "tasks/field_task.h"
 #include "tasks/run.h"
-#include "tasks/task.h"
-#include "tasks/task_library.h"
 #include "tests/tasks/test_configs.h"
 
 namespace hnn::tasks {
@@ -27,6 +26,11 @@ long hnn_parameters(int dim, const std::vector<int>& hidden) {
   return n + in + 1;
 }
 
+// The training settings a run of `task` gets under a preset.
+TrainConfig train_config(const Task& task, Preset preset) {
+  return resolve(task, {.task = task.name(), .preset = preset}).train;
+}
+
 TEST(Presets, AreNamedPaperAndLean) {
   EXPECT_EQ(preset_names(), (std::vector<std::string>{"paper", "lean"}));
 }
@@ -34,7 +38,7 @@ TEST(Presets, AreNamedPaperAndLean) {
 TEST(Presets, PaperIsTheTasksOwnConfiguration) {
   for (const std::string& name : task_names()) {
     const auto task = make_task(name);
-    const TrainConfig own = task->train_config(), paper = train_config(*task, "paper");
+    const TrainConfig own = task->train_config(), paper = train_config(*task, Preset::kPaper);
     EXPECT_EQ(paper.hidden, own.hidden) << name;
     EXPECT_EQ(paper.hidden, (std::vector<int>{200, 200})) << name;
     EXPECT_EQ(paper.steps, own.steps) << name;
@@ -46,8 +50,9 @@ TEST(Presets, PaperIsTheTasksOwnConfiguration) {
 // (whose smaller models' energy error blew up on some seed: its lean model is the paper's).
 TEST(Presets, LeanIsASmallerModelWithEverythingElseThePapers) {
   for (const std::string& name : testing::state_tasks()) {
-    const auto task = make_task(name);
-    const TrainConfig paper = train_config(*task, "paper"), lean = train_config(*task, "lean");
+    const auto task = make_field_task(name);
+    const TrainConfig paper = train_config(*task, Preset::kPaper),
+                      lean = train_config(*task, Preset::kLean);
     EXPECT_EQ(lean.hidden, task->lean_hidden()) << name;
     const int dim = int(task->build_dataset(0).train_x.cols());
     if (name == "three-body") {
@@ -62,27 +67,19 @@ TEST(Presets, LeanIsASmallerModelWithEverythingElseThePapers) {
   }
   // Not swept (10 minutes a run): its lean model is the paper's.
   const auto pixel = make_task("pixel-pendulum");
-  EXPECT_EQ(train_config(*pixel, "lean").hidden, pixel->train_config().hidden);
+  EXPECT_EQ(train_config(*pixel, Preset::kLean).hidden, pixel->train_config().hidden);
 }
 
 TEST(Presets, AnUnknownPresetIsRefusedByName) {
-  const auto task = make_task("spring");
   try {
-    train_config(*task, "tiny");
+    parse_preset("tiny");
     FAIL() << "no exception";
   } catch (const Error& e) {
-    EXPECT_STREQ(e.what(), "unknown preset 'tiny' (known: paper, lean)");
+    EXPECT_STREQ(e.what(), "preset must be paper or lean, got 'tiny'");
   }
-  TempDir dir("run");
-  RunOptions o = testing::small_run("spring", "hnn", dir / "run");
-  o.preset = "Lean";  // names are exact
-  try {
-    run_training(o);
-    FAIL() << "no exception";
-  } catch (const Error& e) {
-    EXPECT_STREQ(e.what(), "--preset must be paper or lean, got 'Lean'");
-  }
-  EXPECT_FALSE(std::filesystem::exists(dir / "run"));
+  EXPECT_THROW(parse_preset("Lean"), Error);  // names are exact
+  EXPECT_EQ(parse_preset("lean"), Preset::kLean);
+  EXPECT_EQ(to_string(Preset::kLean), "lean");
 }
 
 // A run records its preset and trains the preset's widths unless --hidden says otherwise.
@@ -95,7 +92,7 @@ TEST(Presets, RunsUseTheLeanWidthsUnlessHiddenOverrides) {
   TempDir dir("runs");
   RunOptions o = testing::small_run("spring", "hnn", dir / "lean", 3);
   o.hidden.reset();
-  o.preset = "lean";
+  o.preset = Preset::kLean;
   const nlohmann::json m = run_training(o);
   EXPECT_EQ(m["hidden"], lean_text);
   EXPECT_EQ(m["preset"], "lean");
@@ -109,8 +106,8 @@ TEST(Presets, RunsUseTheLeanWidthsUnlessHiddenOverrides) {
 
   o.out = dir / "paper";
   o.hidden.reset();
-  o.preset = "paper";
-  o.model = "baseline";
+  o.preset = Preset::kPaper;
+  o.model = nn::ModelKind::kBaseline;
   EXPECT_EQ(run_training(o)["hidden"], "200-200");
 }
 
@@ -118,10 +115,10 @@ TEST(Presets, RunsUseTheLeanWidthsUnlessHiddenOverrides) {
 TEST(Presets, ResumeOptionsKeepThePreset) {
   TempDir dir("run");
   RunOptions o = testing::small_run("spring", "hnn", dir / "run", 4);
-  o.preset = "lean";
+  o.preset = Preset::kLean;
   run_training(o);
   const RunOptions resumed = resume_options(dir / "run");
-  EXPECT_EQ(resumed.preset, "lean");
+  EXPECT_EQ(resumed.preset, Preset::kLean);
   EXPECT_EQ(*resumed.hidden, (std::vector<int>{16, 16}));  // the widths the run trained
 }
 

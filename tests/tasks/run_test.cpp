@@ -9,6 +9,7 @@
 
 #include <cmath>
 
+#include "tasks/report/table1.h"
 #include "tasks/reproduce.h"
 #include "tasks/task.h"
 #include "tests/tasks/test_configs.h"
@@ -131,11 +132,11 @@ TEST_P(RunFolder, HoldsCompleteMetricsCurvesRolloutsAndLoadableParameters) {
   expect_rollout_csv(dir / "rollout.csv", shape, /*has_h=*/true);
 
   const LoadedRun run = load_run(dir.path());
-  EXPECT_EQ(run.options.task, shape.task);
-  EXPECT_EQ(run.options.model, "hnn");
-  EXPECT_EQ(run.model->name(), "hnn");
-  EXPECT_EQ(run.model->dim(), shape.dim);
-  EXPECT_EQ(run.data.train_x.rows(), shape.n_train);
+  EXPECT_EQ(run.settings.task, shape.task);
+  EXPECT_EQ(run.settings.model, nn::ModelKind::kHnn);
+  EXPECT_EQ(run.run->dynamics().name(), "hnn");
+  EXPECT_EQ(run.run->dynamics().dim(), shape.dim);
+  EXPECT_EQ(run.run->rollout_states(1000).cols(), shape.dim);
   // The saved parameters reproduce the run's numbers exactly.
   const json again = evaluate_run(dir.path(), "", /*write_files=*/false);
   for (const char* key :
@@ -156,7 +157,7 @@ TEST(RunFolderBaseline, HasNoLearnedHamiltonianButEverythingElse) {
   const json m = run_training(testing::small_run("spring", "baseline", dir.path(), 10));
   expect_complete_metrics(m, "spring", "baseline", 0, 10, "double");
   expect_rollout_csv(dir / "rollout.csv", kShapes[0], /*has_h=*/false);
-  EXPECT_EQ(load_run(dir.path()).model->name(), "baseline");
+  EXPECT_EQ(load_run(dir.path()).run->dynamics().name(), "baseline");
 }
 
 TEST(EvaluateRun, WriteFilesRecreatesTheSameRollouts) {
@@ -202,7 +203,7 @@ TEST(RunDeterminism, SameSeedSameNumbersAndFilesOtherSeedOtherNumbers) {
 TEST(RunDtype, FloatAndDoubleBothRunAndAgree) {
   TempDir f("float"), d("double");
   RunOptions in_float = testing::small_run("spring", "hnn", f.path(), 20);
-  in_float.dtype = "float";
+  in_float.dtype = Dtype::kFloat;
   const json mf = run_training(in_float);
   const json md = run_training(testing::small_run("spring", "hnn", d.path(), 20));
   expect_complete_metrics(mf, "spring", "hnn", 0, 20, "float");
@@ -269,7 +270,7 @@ TEST(Reproduce, TableAveragesSeedsAndCarriesThePapersValues) {
                   1e-12 * std::abs(row[key].get<double>()))
           << model << " " << key;
     }
-    const PaperRow paper = task->paper(model);
+    const PaperRow paper = task->paper(parse_model(model));
     EXPECT_EQ(row["paper_train_loss"].get<double>(), paper.train_loss.mean);
     EXPECT_EQ(row["paper_test_loss"].get<double>(), paper.test_loss.mean);
     EXPECT_EQ(row["paper_energy_mse"].get<double>(), paper.energy_mse.mean);

@@ -58,7 +58,7 @@ inline RunOptions small_run(const std::string& task, const std::string& model,
                             const std::filesystem::path& out, int steps = 10) {
   RunOptions o;
   o.task = task;
-  o.model = model;
+  o.model = parse_model(model);
   o.steps = steps;
   o.hidden = std::vector<int>{16, 16};
   o.out = out;

@@ -1,8 +1,6 @@
 // The shared trainer: a short spring run in which the HNN conserves energy far better than the
 // baseline at the same loss, loss curves, minibatch determinism, float training, and errors.
 
-#include "tasks/trainer.h"
-
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -10,8 +8,9 @@
 
 #include "nn/checkpoint.h"
 #include "nn/hnn.h"
-#include "tasks/evaluate.h"
-#include "tasks/task.h"
+#include "tasks/evaluate/rollouts.h"
+#include "tasks/field_task.h"
+#include "tasks/train/field_objective.h"
 #include "tests/tasks/test_configs.h"
 
 namespace hnn::tasks {
@@ -46,7 +45,7 @@ class ShortSpringTraining : public ::testing::Test {
   };
 
   static void SetUpTestSuite() {
-    task_ = make_task("spring").release();
+    task_ = make_field_task("spring").release();
     data_ = new Dataset(task_->build_dataset(0));
     hnn_ = new Trained(train("hnn"));
     baseline_ = new Trained(train("baseline"));
@@ -69,15 +68,15 @@ class ShortSpringTraining : public ::testing::Test {
     t.test = loss_stats(*t.model, data_->test_x, data_->test_dxdt);
     std::mt19937_64 rng(1);
     const Batch x0 = task_->rollout_states(*data_, rng);
-    t.energy = energy_mse(make_rollouts(*task_, *t.model, x0, task_->rollout_config()));
+    t.energy = energy_mse(make_rollouts(task_->truth(), *t.model, x0, task_->rollout_config()));
     return t;
   }
 
-  static Task* task_;
+  static FieldTask* task_;
   static Dataset* data_;
   static Trained *hnn_, *baseline_;
 };
-Task* ShortSpringTraining::task_ = nullptr;
+FieldTask* ShortSpringTraining::task_ = nullptr;
 Dataset* ShortSpringTraining::data_ = nullptr;
 ShortSpringTraining::Trained* ShortSpringTraining::hnn_ = nullptr;
 ShortSpringTraining::Trained* ShortSpringTraining::baseline_ = nullptr;
@@ -141,7 +140,7 @@ TrainConfig tiny_config(int steps, int batch_size = 0) {
 }
 
 TEST(Trainer, MinibatchRunIsDeterministicPerSeed) {
-  const Dataset d = make_task("spring")->build_dataset(0);
+  const Dataset d = make_field_task("spring")->build_dataset(0);
   const auto run = [&](std::uint64_t seed) {
     auto model = new_model<double>("hnn", 2, {16, 16}, 3);
     const TrainResult r =
@@ -165,7 +164,7 @@ TEST(Trainer, MinibatchRunIsDeterministicPerSeed) {
 }
 
 TEST(Trainer, FullBatchIgnoresTheSeed) {
-  const Dataset d = make_task("spring")->build_dataset(0);
+  const Dataset d = make_field_task("spring")->build_dataset(0);
   auto a = new_model<double>("baseline", 2, {16, 16}, 3);
   auto b = new_model<double>("baseline", 2, {16, 16}, 3);
   train_model<double>(*a, d, tiny_config(20), 1, {.quiet = true});
@@ -174,7 +173,7 @@ TEST(Trainer, FullBatchIgnoresTheSeed) {
 }
 
 TEST(Trainer, RecordsAtTheRequestedIntervalAndTheLastStep) {
-  const Dataset d = make_task("spring")->build_dataset(0);
+  const Dataset d = make_field_task("spring")->build_dataset(0);
   auto model = new_model<double>("hnn", 2, {16, 16}, 3);
   TrainConfig config = tiny_config(25);
   config.record_every = 10;
@@ -194,7 +193,7 @@ TEST(Trainer, RecordsAtTheRequestedIntervalAndTheLastStep) {
 }
 
 TEST(Trainer, WeightDecayShrinksTheParameters) {
-  const Dataset d = make_task("spring")->build_dataset(0);
+  const Dataset d = make_field_task("spring")->build_dataset(0);
   auto plain = new_model<double>("baseline", 2, {16, 16}, 3);
   auto decayed = new_model<double>("baseline", 2, {16, 16}, 3);
   TrainConfig config = tiny_config(100);
@@ -206,7 +205,7 @@ TEST(Trainer, WeightDecayShrinksTheParameters) {
 }
 
 TEST(Trainer, FloatTrainsLikeDouble) {
-  const Dataset d = make_task("spring")->build_dataset(0);
+  const Dataset d = make_field_task("spring")->build_dataset(0);
   auto in_double = new_model<double>("hnn", 2, {16, 16}, 3);
   std::unique_ptr<nn::DynamicsModel<float>> in_float = nn::cast_model<float>(*in_double);
   const TrainResult rd = train_model<double>(*in_double, d, tiny_config(50), 0, {.quiet = true});
@@ -220,7 +219,7 @@ TEST(Trainer, FloatTrainsLikeDouble) {
 }
 
 TEST(Trainer, NonFiniteLossStopsWithTrainingDiverged) {
-  Dataset d = make_task("spring")->build_dataset(0);
+  Dataset d = make_field_task("spring")->build_dataset(0);
   d.train_dxdt(5, 1) = std::numeric_limits<double>::quiet_NaN();
   auto model = new_model<double>("hnn", 2, {16, 16}, 3);
   try {
@@ -233,7 +232,7 @@ TEST(Trainer, NonFiniteLossStopsWithTrainingDiverged) {
 }
 
 TEST(Trainer, RejectsImpossibleSettings) {
-  const Dataset d = make_task("spring")->build_dataset(0);
+  const Dataset d = make_field_task("spring")->build_dataset(0);
   auto model = new_model<double>("hnn", 2, {16, 16}, 3);
   EXPECT_THROW(train_model<double>(*model, d, tiny_config(0), 0, {.quiet = true}), std::exception);
   EXPECT_THROW(train_model<double>(*model, d, tiny_config(5, 751), 0, {.quiet = true}),
