@@ -44,16 +44,25 @@ TEST(TanhKernel, FusedAndGenericForwardGiveBitIdenticalValues) {
   expect_fused_and_generic_tanh_identical<float>();
 }
 
+// Eigen computes the unaligned head and the short tail of a buffer with scalar functions; for
+// double they round differently from the packet ones on about 1.6% of inputs, so 1000 inputs
+// alone (1x1, all "tail") and shifted against the packet boundaries catch a kernel that lets
+// Eigen choose.
 template <typename T>
 void expect_position_independent() {
   ad::TapeScope scope;
-  const ad::Matrix<T> x = random_matrix(1, 200, 34, -4, 4).cast<T>();
+  const ad::Matrix<T> x = random_matrix(1, 1000, 34, -4, 4).cast<T>();
   const ad::Matrix<T> whole = ad::tanh(Var<T>::constant(x)).value();
-  for (Eigen::Index start : {1, 3, 67}) {  // an element's value must not depend on its address
+  for (Eigen::Index start : {1, 3, 67}) {
     const ad::Matrix<T> part = x.rightCols(x.cols() - start);
     EXPECT_EQ(ad::tanh(Var<T>::constant(part)).value(), whole.rightCols(x.cols() - start))
         << "from column " << start;
   }
+  int differ = 0;
+  for (Eigen::Index i = 0; i < x.cols(); ++i) {
+    differ += ad::tanh(Var<T>::constant(x.col(i))).value()(0, 0) != whole(0, i);
+  }
+  EXPECT_EQ(differ, 0) << "of " << x.cols() << " elements computed alone";
 }
 
 TEST(TanhKernel, ValueDoesNotDependOnWhereTheElementSits) {
