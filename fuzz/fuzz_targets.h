@@ -19,10 +19,10 @@
 #include "nn/hnn.h"
 #include "physics/lipson.h"
 #include "physics/types.h"
+#include "tasks/field_task.h"
+#include "tasks/report/run_folder.h"
 #include "tasks/run.h"
-#include "tasks/task.h"
-#include "tasks/task_library.h"
-#include "tasks/train_checkpoint.h"
+#include "tasks/train/checkpoint.h"
 
 #define FUZZ_CHECK(cond)                                                                \
   do {                                                                                  \
@@ -67,10 +67,12 @@ inline void lipson_input(const std::string& path) {
   FUZZ_CHECK(data.values.allFinite() && data.t.allFinite());
   for (Eigen::Index i = 1; i < rows; ++i) FUZZ_CHECK(data.line(i) > data.line(i - 1));
   FUZZ_CHECK(data.select_trial(data.trial(0)).rows() >= 1);
-  const auto task = tasks::make_task("real-pendulum");
-  task->set_data_file(path);
+  const auto task = tasks::make_field_task("real-pendulum");
+  tasks::RunSettings settings;
+  settings.task = task->name();
+  settings.data_file = path;
   try {
-    const tasks::Dataset d = task->build_dataset(0);
+    const tasks::Dataset d = task->build_dataset(settings);
     FUZZ_CHECK(d.train_x.rows() > 0 && d.test_x.rows() > 0);
     FUZZ_CHECK(d.train_x.allFinite() && d.train_dxdt.allFinite());
   } catch (const tasks::Error&) {
@@ -112,7 +114,8 @@ inline void parameters_input(const std::string& path) {
 /// `hnn train --resume` takes from it, checked as the program checks them.
 inline void train_state_input(const std::filesystem::path& run_dir) {
   try {
-    const tasks::TrainState state = tasks::read_train_state(tasks::checkpoint_dir(run_dir));
+    const tasks::TrainState state =
+        tasks::read_train_state(tasks::RunFolder(run_dir).checkpoint_dir());
     FUZZ_CHECK(state.step >= 0 && state.step <= state.total_steps);
     FUZZ_CHECK(state.params_file.find('/') == std::string::npos);
     const tasks::RunOptions options = tasks::resume_options(run_dir);

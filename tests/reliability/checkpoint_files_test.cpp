@@ -12,9 +12,9 @@
 #include "nn/checkpoint.h"
 #include "nn/hnn.h"
 #include "reliability_util.h"
-#include "tasks/task_library.h"
-#include "tasks/train_checkpoint.h"
-#include "tasks/trainer.h"
+#include "tasks/field_task.h"
+#include "tasks/train/checkpoint.h"
+#include "tasks/train/loop.h"
 
 namespace hnn::reliability {
 namespace {
@@ -105,7 +105,7 @@ TEST_F(CheckpointFiles, EveryBadCheckpointIsOneLineAndChangesNoFile) {
        [](const fs::path& run) {
          edit_state(run, [](nlohmann::json& s) { s["run"].erase("seed"); });
        },
-       "the checkpoint in 'RUN/checkpoint' lacks the run's settings: "
+       "the checkpoint in 'RUN/checkpoint' does not hold a run's settings: "
        "[json.exception.out_of_range.403] key 'seed' not found"},
       {"other-step-count",
        [](const fs::path& run) {
@@ -179,7 +179,7 @@ struct SpringRun {
 
 SpringRun spring_run() {
   SpringRun run;
-  const auto task = tasks::make_task("spring");
+  const auto task = tasks::make_field_task("spring");
   run.data = task->build_dataset(4);
   run.config = task->train_config();
   run.config.steps = 30;
@@ -193,13 +193,13 @@ SpringRun spring_run() {
   return run;
 }
 
-tasks::TrainHooks checkpoint_hooks(const fs::path& dir, bool resume) {
-  tasks::TrainHooks hooks;
-  hooks.quiet = true;
-  hooks.checkpoint_dir = dir;
-  hooks.checkpoint_every = 10;
-  hooks.resume = resume;
-  return hooks;
+tasks::LoopOptions checkpoint_loop(const fs::path& dir, bool resume) {
+  tasks::LoopOptions loop;
+  loop.quiet = true;
+  loop.checkpoint_dir = dir;
+  loop.checkpoint_every = 10;
+  loop.resume = resume;
+  return loop;
 }
 
 // A kill between writing step-N.bin and committing state.json, or during a write, leaves an
@@ -212,10 +212,10 @@ TEST(CheckpointLeftovers, AreIgnoredByResumeAndRemovedByTheNextCheckpoint) {
 
   SpringRun first = spring_run();
   tasks::StopSignal stop;
-  tasks::TrainHooks hooks = checkpoint_hooks(ckpt, false);
-  hooks.stop = &stop;
-  hooks.on_record = [&](long step) { stop.requested = step == 12; };
-  EXPECT_THROW(tasks::train_model<double>(*first.model, first.data, first.config, 4, hooks),
+  tasks::LoopOptions loop = checkpoint_loop(ckpt, false);
+  loop.stop = &stop;
+  loop.on_record = [&](long step) { stop.requested = step == 12; };
+  EXPECT_THROW(tasks::train_model<double>(*first.model, first.data, first.config, 4, loop),
                tasks::TrainingInterrupted);
   ASSERT_EQ(tasks::read_train_state(ckpt).step, 12);
   // A complete but uncommitted later checkpoint (another run's bytes), and torn temporaries.
@@ -227,7 +227,7 @@ TEST(CheckpointLeftovers, AreIgnoredByResumeAndRemovedByTheNextCheckpoint) {
 
   SpringRun resumed = spring_run();
   tasks::train_model<double>(*resumed.model, resumed.data, resumed.config, 4,
-                             checkpoint_hooks(ckpt, true));
+                             checkpoint_loop(ckpt, true));
   const auto a = whole.model->parameters(), b = resumed.model->parameters();
   for (std::size_t i = 0; i < a.size(); ++i) EXPECT_EQ(a[i].value(), b[i].value()) << i;
   std::vector<std::string> left;
@@ -243,7 +243,7 @@ TEST(CheckpointLeftovers, AreIgnoredByResumeAndRemovedByTheNextCheckpoint) {
 TEST(Divergence, BetweenCheckpointsKeepsTheEarlierOneIntact) {
   const TempDir dir;
   SpringRun reference = spring_run();
-  tasks::TrainHooks at_ten = checkpoint_hooks(dir / "reference", false);
+  tasks::LoopOptions at_ten = checkpoint_loop(dir / "reference", false);
   tasks::StopSignal stop;
   at_ten.stop = &stop;
   at_ten.on_record = [&](long step) { stop.requested = step == 10; };
@@ -253,14 +253,14 @@ TEST(Divergence, BetweenCheckpointsKeepsTheEarlierOneIntact) {
 
   const fs::path ckpt = dir / "checkpoint";
   SpringRun run = spring_run();
-  tasks::TrainHooks hooks = checkpoint_hooks(ckpt, false);
-  hooks.on_record = [&](long step) {
+  tasks::LoopOptions loop = checkpoint_loop(ckpt, false);
+  loop.on_record = [&](long step) {
     if (step == 13) {
       run.model->parameters()[0].mutable_value()(0, 0) = std::numeric_limits<double>::quiet_NaN();
     }
   };
   try {
-    tasks::train_model<double>(*run.model, run.data, run.config, 4, hooks);
+    tasks::train_model<double>(*run.model, run.data, run.config, 4, loop);
     ADD_FAILURE() << "trained through NaN parameters";
   } catch (const tasks::TrainingDiverged& e) {
     EXPECT_EQ(e.step(), 14);
@@ -278,7 +278,7 @@ TEST(Divergence, BetweenCheckpointsKeepsTheEarlierOneIntact) {
             read_text(dir / "reference" / tasks::read_train_state(dir / "reference").params_file));
   SpringRun loaded = spring_run();
   nn::Adam<double> adam(loaded.model->parameters());
-  tasks::load_train_checkpoint<double>(ckpt, state, *loaded.model, adam);
+  tasks::load_train_checkpoint<double>(ckpt, state, *loaded.model, std::span(&adam, 1));
   for (const auto& p : loaded.model->parameters()) EXPECT_TRUE(p.value().allFinite());
 }
 

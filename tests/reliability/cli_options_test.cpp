@@ -48,7 +48,8 @@ std::vector<BadOption> bad_train_options() {
       {{"train", "spring", "--checkpoint-every", "0"}, "--checkpoint-every: " + positive + "'0'"},
       {{"train", "spring", "--checkpoint-every", "x"}, "--checkpoint-every: " + positive + "'x'"},
       {{"train", "spring", "--data", "x.txt"},
-       "task 'spring' does not read a data file (--data applies to real-pendulum)"},
+       "task 'spring' does not read a data file (--data applies to measured-data tasks such as "
+       "real-pendulum)"},
       {{"train", "spring", "--bogus"}, "The following argument was not expected: --bogus"},
       {{"train"}, "train needs a TASK (or --resume DIR)"},
   };

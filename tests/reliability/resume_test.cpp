@@ -9,13 +9,17 @@
 #include "nn/checkpoint.h"
 #include "nn/hnn.h"
 #include "reliability_util.h"
+#include "tasks/field_task.h"
+#include "tasks/report/run_folder.h"
 #include "tasks/run.h"
-#include "tasks/task_library.h"
-#include "tasks/train_checkpoint.h"
-#include "tasks/trainer.h"
+#include "tasks/train/checkpoint.h"
+#include "tasks/train/loop.h"
 
 namespace hnn::reliability {
 namespace {
+
+// RUN/checkpoint, where a run keeps its training checkpoints.
+fs::path checkpoint_dir(const fs::path& run) { return tasks::RunFolder(run).checkpoint_dir(); }
 
 // ---- the library: train_model stopped and resumed -------------------------------------------
 
@@ -29,7 +33,7 @@ struct Trained {
 // resumes from `dir` when `resume` is set.
 template <typename T>
 Trained<T> train_spring(int batch, long stop_at, const fs::path& dir, bool resume) {
-  const auto task = tasks::make_task("spring");
+  const auto task = tasks::make_field_task("spring");
   const tasks::Dataset data = task->build_dataset(4);
   tasks::TrainConfig config = task->train_config();
   config.steps = 40;
@@ -40,16 +44,16 @@ Trained<T> train_spring(int batch, long stop_at, const fs::path& dir, bool resum
   std::mt19937_64 init(4);
   const auto model = nn::make_model<T>(model_config, init);
   tasks::StopSignal stop;
-  tasks::TrainHooks hooks;
-  hooks.quiet = true;
-  hooks.on_record = [&](long step) { stop.requested = step == stop_at; };
-  hooks.checkpoint_dir = dir;
-  hooks.checkpoint_every = 10;
-  hooks.resume = resume;
-  hooks.stop = &stop;
+  tasks::LoopOptions loop;
+  loop.quiet = true;
+  loop.on_record = [&](long step) { stop.requested = step == stop_at; };
+  loop.checkpoint_dir = dir;
+  loop.checkpoint_every = 10;
+  loop.resume = resume;
+  loop.stop = &stop;
   Trained<T> out;
   try {
-    out.curve = tasks::train_model<T>(*model, data, config, 4, hooks).curve;
+    out.curve = tasks::train_model<T>(*model, data, config, 4, loop).curve;
   } catch (const tasks::TrainingInterrupted& e) {
     EXPECT_EQ(e.step(), stop_at);
     EXPECT_EQ(e.what(), fmt::format("training stopped at step {} of 40; checkpoint in {}", stop_at,
@@ -112,7 +116,7 @@ std::vector<std::string> long_run(const fs::path& out, const std::string& every)
 
 long checkpoint_step(const fs::path& run) {
   try {
-    return tasks::read_train_state(tasks::checkpoint_dir(run)).step;
+    return tasks::read_train_state(checkpoint_dir(run)).step;
   } catch (const std::exception&) {
     return -1;
   }
@@ -162,7 +166,7 @@ TEST_F(ResumeCli, SigintStopsAfterTheStepCheckpointsAndSaysHowToResume) {
             fmt::format("\nhnn: stopping after this step (press Ctrl-C again to quit now)\n"
                         "hnn: training stopped at step {} of 30000; checkpoint in {}\n"
                         "hnn: resume with: hnn train --resume {}\n",
-                        step, tasks::checkpoint_dir(run).string(), run.string()));
+                        step, checkpoint_dir(run).string(), run.string()));
   EXPECT_FALSE(fs::exists(run / "metrics.json"));
   // A fresh run into the folder would lose the checkpoint: refused.
   const Result fresh = run_hnn(long_run(run, "1000"), dir_.path());
@@ -170,7 +174,7 @@ TEST_F(ResumeCli, SigintStopsAfterTheStepCheckpointsAndSaysHowToResume) {
   EXPECT_EQ(fresh.err, fmt::format("hnn: error: '{0}' holds an unfinished run (step {1} of "
                                    "30000): continue it with `hnn train --resume {0}`, or choose "
                                    "another --out, or delete '{2}'\n",
-                                   run.string(), step, tasks::checkpoint_dir(run).string()));
+                                   run.string(), step, checkpoint_dir(run).string()));
   const Result resumed = run_hnn({"train", "--resume", run.string(), "--quiet"}, dir_.path());
   ASSERT_EQ(resumed.code, 0) << resumed.err;
   expect_same_as_whole(run);
@@ -181,13 +185,13 @@ TEST_F(ResumeCli, SigintStopsAfterTheStepCheckpointsAndSaysHowToResume) {
 // write, or a complete .bin of a checkpoint killed before its commit (or after, before the
 // older one's removal): see Note [Checkpoint commit].
 void expect_complete_files(const fs::path& run) {
-  const tasks::TrainState state = tasks::read_train_state(tasks::checkpoint_dir(run));
+  const tasks::TrainState state = tasks::read_train_state(checkpoint_dir(run));
   nn::DynamicsConfig config;
   config.hidden = {16};
   std::mt19937_64 rng(0);
   const auto model = nn::make_model<double>(config, rng);
   nn::Adam<double> adam(model->parameters());
-  tasks::load_train_checkpoint<double>(tasks::checkpoint_dir(run), state, *model, adam);
+  tasks::load_train_checkpoint<double>(checkpoint_dir(run), state, *model, std::span(&adam, 1));
   EXPECT_EQ(adam.step_count(), state.step);
   for (const auto& entry : fs::recursive_directory_iterator(run)) {
     const std::string name = entry.path().filename().string();
@@ -264,7 +268,7 @@ TEST_F(ResumeCli, SigtermStopsLikeSigint) {
   EXPECT_TRUE(child.err().ends_with(
       fmt::format("hnn: training stopped at step {} of 30000; checkpoint in {}\n"
                   "hnn: resume with: hnn train --resume {}\n",
-                  step, tasks::checkpoint_dir(run).string(), run.string())))
+                  step, checkpoint_dir(run).string(), run.string())))
       << child.err();
   expect_complete_files(run);
 }
@@ -285,10 +289,10 @@ TEST(Divergence, StopsAtTheStepAndKeepsTheLastGoodCheckpoint) {
     EXPECT_EQ(r.code, 1);
     EXPECT_EQ(r.err, fmt::format("hnn: error: training diverged at step 2: {}; the last good "
                                  "checkpoint (step 1) is kept in {}\n",
-                                 reason, tasks::checkpoint_dir(run).string()));
+                                 reason, checkpoint_dir(run).string()));
     EXPECT_FALSE(fs::exists(run / "metrics.json"));
     EXPECT_FALSE(fs::exists(run / "params.bin"));
-    const tasks::TrainState state = tasks::read_train_state(tasks::checkpoint_dir(run));
+    const tasks::TrainState state = tasks::read_train_state(checkpoint_dir(run));
     EXPECT_EQ(state.step, 1);
     ASSERT_EQ(state.curve.size(), 1u);
     EXPECT_TRUE(std::isfinite(state.curve[0].train_loss));
