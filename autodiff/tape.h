@@ -1,7 +1,8 @@
 #pragma once
 // The tape: the per-thread record of op results, in execution order. Nodes are recycled, not
-// freed: a TapeScope rewinds the tape when it ends, and the next step reuses the same nodes and
-// their value buffers, so a repeated training step allocates nothing in steady state.
+// freed: a TapeScope rewinds the tape when it ends, and the next step reuses the same nodes, their
+// value buffers and their typed op state (OpState, var.h), so a repeated training step allocates
+// nothing in steady state.
 
 #include <cstddef>
 #include <memory>
