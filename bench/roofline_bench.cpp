@@ -24,7 +24,7 @@
 
 #include "autodiff/autodiff.h"
 #include "nn/nn.h"
-#include "tasks/pixel_pendulum.h"
+#include "tasks/pixel/model.h"
 
 namespace ad = hnn::ad;
 namespace nn = hnn::nn;

@@ -13,29 +13,28 @@ using nlohmann::json;
 
 namespace {
 
-std::string joined(const std::vector<std::string>& names) {
-  std::string s;
-  for (const std::string& n : names) s += (s.empty() ? "" : ", ") + n;
-  return s;
-}
-
 // "200-200" (metrics.json's form) or [200, 200] -> {200, 200}; throws Error on anything else.
 std::vector<int> widths_from_json(const json& j) {
-  if (j.is_array()) {
-    std::vector<int> widths;
-    for (const json& w : j) widths.push_back(json_integer<int>(w, "a hidden width"));
-    return widths;
-  }
-  const std::string text = j.get<std::string>();
+  const std::string text = j.is_array() ? j.dump() : j.get<std::string>();
+  const auto bad = [&] {
+    return Error(fmt::format("hidden '{}' is not widths of 1..{} joined by '-' (like 200-200)",
+                             text, kMaxWidth));
+  };
   std::vector<int> widths;
-  std::stringstream in(text);
-  for (std::string w; std::getline(in, w, '-');) {
-    int width = 0;
-    const auto [end, ec] = std::from_chars(w.data(), w.data() + w.size(), width);
-    HNN_TASKS_CHECK(ec == std::errc() && end == w.data() + w.size(),
-                    "hidden '{}' is not widths joined by '-' (like 200-200)", text);
-    widths.push_back(width);
+  if (j.is_array()) {
+    for (const json& w : j) widths.push_back(json_integer<int>(w, "a hidden width"));
+  } else {
+    std::stringstream in(text);
+    for (std::string w; std::getline(in, w, '-');) {
+      int width = 0;
+      const auto [end, ec] = std::from_chars(w.data(), w.data() + w.size(), width);
+      if (ec != std::errc() || end != w.data() + w.size()) throw bad();
+      widths.push_back(width);
+    }
   }
+  if (widths.empty()) throw bad();
+  for (int w : widths)
+    if (w < 1 || w > kMaxWidth) throw bad();
   return widths;
 }
 

@@ -54,14 +54,14 @@ decltype(auto) with_scalar(Dtype dtype, F&& f) {
 }
 
 struct RunSettings {
-  std::string task;
+  std::string task{};
   nn::ModelKind model = nn::ModelKind::kHnn;
   std::uint64_t seed = 0;
   Dtype dtype = Dtype::kDouble;
   Preset preset = Preset::kPaper;
   int threads = 2;  // the engine's threads: fused kernels split each batch into row blocks
-  TrainConfig train;
-  std::string data_file;  // measured-data tasks: another file of the same format
+  TrainConfig train{};
+  std::string data_file{};  // measured-data tasks: another file of the same format
   nlohmann::json task_settings = nlohmann::json::object();  // the task's own (Task::open)
 
   /// The form metrics.json and checkpoints hold ("hidden": "200-200").
@@ -69,22 +69,22 @@ struct RunSettings {
 };
 
 struct RunOptions {
-  std::string task;
+  std::string task{};
   nn::ModelKind model = nn::ModelKind::kHnn;
   std::uint64_t seed = 0;
   Dtype dtype = Dtype::kDouble;
   Preset preset = Preset::kPaper;
   int threads = 2;
-  std::optional<int> steps, batch_size;
-  std::optional<std::vector<int>> hidden;  // overrides the preset's widths
-  std::optional<double> learning_rate, weight_decay;
-  std::string data_file;
+  std::optional<int> steps{}, batch_size{};
+  std::optional<std::vector<int>> hidden{};  // overrides the preset's widths
+  std::optional<double> learning_rate{}, weight_decay{};
+  std::string data_file{};
   nlohmann::json task_settings = nlohmann::json::object();
-  std::filesystem::path out;
+  std::filesystem::path out{};
   bool quiet = false;
   /// Checkpoints into out/checkpoint every this many steps (default: a tenth of the steps), at
   /// the end, and when stopped.
-  std::optional<long> checkpoint_every;
+  std::optional<long> checkpoint_every{};
   /// Continue the run in `out` from its last checkpoint (see resume_options).
   bool resume = false;
   /// Polled by the training loop (e.g. set on SIGINT): checkpoint and stop after the step.

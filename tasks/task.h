@@ -31,7 +31,7 @@ struct PaperRow {
 struct RolloutRequest {
   std::string integrator = "dopri5";
   double dt = 1e-2, rtol = 1e-9;
-  std::optional<double> t_end;  // default: the evaluation's rollout span
+  std::optional<double> t_end{};  // default: the evaluation's rollout span
   int points = 200, trajectories = 5;
 };
 

@@ -23,9 +23,9 @@
 #include "nn/hnn.h"
 #include "nn/loss.h"
 #include "nn/optim.h"
-#include "tasks/pixel_pendulum.h"
-#include "tasks/task.h"
-#include "tasks/trainer.h"
+#include "tasks/field_task.h"
+#include "tasks/pixel/model.h"
+#include "tasks/train/field_objective.h"
 
 namespace {
 
@@ -68,8 +68,7 @@ cmp::Data build_data(const cmp::Options& o) {
     return {to_rows(pixel_split(d, t, n, false)), to_rows(pixel_split(d, t, n, true)),
             to_rows(pixel_split(d, 0, t, false)), to_rows(pixel_split(d, 0, t, true))};
   }
-  const hnn::tasks::Dataset d =
-      hnn::tasks::make_task(cmp::task_name(o.task))->build_dataset(o.seed);
+  const hnn::tasks::Dataset d = hnn::tasks::build_dataset(cmp::task_name(o.task), o.seed);
   return {to_rows(d.train_x), to_rows(d.train_dxdt), to_rows(d.test_x), to_rows(d.test_dxdt)};
 }
 

@@ -141,7 +141,7 @@ class PixelModel(torch.nn.Module):
         self.dyn = Dynamics(2, hnn)
 
     def loss_terms(self, x, x_next, create_graph=True):
-        """Per-sample total = ae + cc + 0.1 hnn (tasks/pixel_pendulum.h's pixel_loss)."""
+        """Per-sample total = ae + cc + 0.1 hnn (tasks/pixel/model.h's pixel_loss)."""
         z, z_next = self.ae.encode(x), self.ae.encode(x_next)
         ae = (self.ae.decode(z) - x).pow(2).mean(1)
         hnn = (z_next - (z + self.dyn(z, create_graph))).pow(2).mean(1)

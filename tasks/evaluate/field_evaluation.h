@@ -13,8 +13,8 @@
 namespace hnn::tasks {
 
 struct FieldEvaluation {
-  nlohmann::json metrics;  // train/test loss and energy MSE with standard errors, counts, time
-  Rollouts rollouts;
+  nlohmann::json metrics{};  // train/test loss and energy MSE with standard errors, counts, time
+  Rollouts rollouts{};
 };
 
 /// Evaluates `model` on `data` and on rollouts from `x0` against `truth`.

@@ -51,11 +51,7 @@ double mean_of(const std::vector<double>& v) {
   return v.empty() ? NAN : s / double(v.size());
 }
 
-}  // namespace
-
-BumpResult energy_bump(const PixelModel<double>& model, const PixelData& data,
-                       const PixelConfig& config, const BumpOptions& o) {
-  (void)config;
+void check_options(const PixelModel<double>& model, const PixelData& data, const BumpOptions& o) {
   HNN_TASKS_CHECK(model.is_hnn(), "the energy bump needs an HNN run: a baseline learns no H");
   HNN_TASKS_CHECK(o.trajectory >= -1 && o.trajectory < data.test_trials(),
                   "--trajectory must be in [0, {}) (or -1: automatic), got {}", data.test_trials(),
@@ -65,130 +61,161 @@ BumpResult energy_bump(const PixelModel<double>& model, const PixelData& data,
   HNN_TASKS_CHECK(
       std::isfinite(o.riemann) && std::isfinite(o.raise) && (o.riemann != 0 || o.raise != 0),
       "bump: give a non-zero --raise or --riemann");
-  const physics::GymPendulum scene;
-  const nn::DynamicsModel<double>& dynamics = model.dynamics();
-  const physics::VectorField symplectic =
+}
+
+physics::VectorField symplectic_field(const nn::DynamicsModel<double>& dynamics) {
+  return
       [&dynamics](double, const physics::Batch& z, physics::Batch& dz) { dz = dynamics.field(z); };
-  // S_H = (dH/dp, -dH/dq), so R_H = (dH/dq, dH/dp) = (-S_p, S_q): H grows along it at the rate
-  // |grad H|^2. Lowering H follows -R_H.
-  const double target_sign = o.riemann != 0 ? o.riemann : o.raise;
-  const double sign = target_sign >= 0 ? 1.0 : -1.0;
-  const physics::VectorField riemann = [&dynamics, sign](double, const physics::Batch& z,
-                                                         physics::Batch& dz) {
+}
+
+// S_H = (dH/dp, -dH/dq), so R_H = (dH/dq, dH/dp) = (-S_p, S_q): H grows along it at the rate
+// |grad H|^2. Lowering H (sign -1) follows -R_H.
+physics::VectorField riemann_field(const nn::DynamicsModel<double>& dynamics, double sign) {
+  return [&dynamics, sign](double, const physics::Batch& z, physics::Batch& dz) {
     const physics::Batch s = dynamics.field(z);
     dz.resize(s.rows(), 2);
     dz.col(0) = -sign * s.col(1);
     dz.col(1) = sign * s.col(0);
   };
-  // The test trials' first pairs: their learned H sets the scale of `raise`; the default start
-  // is the trial at the 25th percentile of their H (room to rise; the 75th to fall).
+}
+
+// The test trials' first pairs: their learned H sets the scale of `raise`; the default start is
+// the trial at the 25th percentile of their H (room to rise; the 75th to fall).
+struct Start {
+  int trajectory;
+  physics::Batch z0;
+  Eigen::VectorXd h_firsts;
+};
+
+Start choose_start(const PixelModel<double>& model, const PixelData& data, int trajectory,
+                   double sign) {
   std::vector<Eigen::Index> firsts;
   for (int i = 0; i < data.test_trials(); ++i)
     firsts.push_back(Eigen::Index(i) * data.pairs_per_trial());
-  const Eigen::VectorXd h_firsts =
-      model.energy(model.encode(data.pairs_of<double>(firsts, false))).col(0);
-  int trajectory = o.trajectory;
-  if (trajectory < 0) {
+  Start s{trajectory, {}, model.energy(model.encode(data.pairs_of<double>(firsts, false))).col(0)};
+  if (s.trajectory < 0) {
     std::vector<int> order(firsts.size());
     std::iota(order.begin(), order.end(), 0);
-    std::sort(order.begin(), order.end(), [&](int a, int b) { return h_firsts(a) < h_firsts(b); });
-    trajectory = order[sign > 0 ? order.size() / 4 : order.size() * 3 / 4];
+    std::sort(order.begin(), order.end(),
+              [&](int a, int b) { return s.h_firsts(a) < s.h_firsts(b); });
+    s.trajectory = order[sign > 0 ? order.size() / 4 : order.size() * 3 / 4];
   }
-  const physics::Batch z0 =
-      model.encode(data.pairs_of<double>({firsts[std::size_t(trajectory)]}, false));
+  s.z0 = model.encode(data.pairs_of<double>({firsts[std::size_t(s.trajectory)]}, false));
+  return s;
+}
+
+// The time along R_H at which H has risen (or fallen) from its value at z1 by `raise` times its
+// spread over the test trials' first pairs.
+double riemann_time_for_raise(const PixelModel<double>& model, const physics::VectorField& riemann,
+                              const physics::Batch& z1, const Eigen::VectorXd& h_firsts,
+                              double raise, double sign) {
+  const double spread = h_firsts.maxCoeff() - h_firsts.minCoeff();
+  HNN_TASKS_CHECK(spread > 0,
+                  "bump: --raise is a fraction of the spread of H over the test trials, and {} "
+                  "test trial(s) have none; give --riemann instead",
+                  h_firsts.size());
+  const double target = model.energy(z1)(0, 0) + raise * spread;
+  const Phase probe = integrate_phase("riemann", riemann, z1, kMaxRiemannTime, kProbePoints);
+  const Eigen::VectorXd h = model.energy(probe.z).col(0);
+  for (Eigen::Index k = 1; k < h.size(); ++k) {
+    if ((h(k) - target) * sign >= 0) {  // crossed: interpolate the time linearly
+      const double f = (target - h(k - 1)) / (h(k) - h(k - 1));
+      const double t0 = probe.t[std::size_t(k) - 1], t1 = probe.t[std::size_t(k)];
+      return t0 + f * (t1 - t0);
+    }
+  }
+  throw Error(
+      fmt::format("bump: H did not change by {} x its spread within {} time units along "
+                  "R_H",
+                  raise, kMaxRiemannTime));
+}
+
+// What the phases show: the CSV rows, one image per output, and per phase the learned H, the
+// energy recovered from the decoded frames and the swing's amplitude.
+struct Record {
+  std::string csv = "phase,t,z_q,z_p,learned_h,theta,p,energy\n";
+  std::vector<GrayImage> images;
+  std::vector<double> h[3], energy[3];
+  double amplitude[3] = {0, 0, 0};
+};
+
+void record_phase(const PixelModel<double>& model, const physics::VectorField& symplectic,
+                  const Phase& p, std::size_t phase, double t0, Record& r) {
+  const physics::GymPendulum scene;
+  const Eigen::VectorXd h = model.energy(p.z).col(0);
+  const physics::Batch pairs = model.decode(p.z);
+  const physics::Batch next = model.decode(one_frame_later(symplectic, p.z));
+  for (Eigen::Index k = (phase == 0 ? 0 : 1); k < p.z.rows(); ++k) {  // phases share endpoints
+    const Eigen::RowVector2d x =
+        state_from_frames(scene, pairs.row(k).head(kFramePixels), next.row(k).head(kFramePixels));
+    const double e = scene.energy(x);
+    r.csv += fmt::format("{},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g}\n", p.name,
+                         t0 + p.t[std::size_t(k)], p.z(k, 0), p.z(k, 1), h(k), x(0), x(1), e);
+    r.h[phase].push_back(h(k));
+    r.energy[phase].push_back(e);
+    r.amplitude[phase] = std::max(r.amplitude[phase], std::abs(x(0)));
+    GrayImage image(kSide * kScale + 2 * kGap, kSide * kScale + 2 * kGap,
+                    phase == 1 ? 128 : 64);  // a lighter border while R_H is integrated
+    draw_frame(image, kGap, kGap, pairs.row(k).tail(kFramePixels).cast<float>(), kSide, kScale,
+               physics::GymPendulum::kIntensity);
+    r.images.push_back(std::move(image));
+  }
+}
+
+// bump.csv, bump.gif and bump_strip.png (every 4th image, in one row).
+std::vector<fs::path> write_bump_files(const Record& r, const fs::path& out) {
+  fs::create_directories(out);
+  write_file_atomic(out / "bump.csv", r.csv);
+  write_gif(out / "bump.gif", r.images, 5);
+  const int stride = 4, tile = kSide * kScale + 2 * kGap;
+  const int cols = int((r.images.size() - 1) / stride) + 1;
+  GrayImage strip(cols * tile, tile, 64);
+  for (int c = 0; c < cols; ++c) {
+    const GrayImage& img = r.images[std::size_t(c * stride)];
+    for (int y = 0; y < img.height; ++y)
+      for (int x = 0; x < img.width; ++x) strip.at(c * tile + x, y) = img.at(x, y);
+  }
+  write_png(out / "bump_strip.png", strip);
+  return {out / "bump.csv", out / "bump.gif", out / "bump_strip.png"};
+}
+
+}  // namespace
+
+BumpResult energy_bump(const PixelModel<double>& model, const PixelData& data, const PixelConfig&,
+                       const BumpOptions& o) {
+  check_options(model, data, o);
+  const double sign = (o.riemann != 0 ? o.riemann : o.raise) >= 0 ? 1.0 : -1.0;
+  const physics::VectorField symplectic = symplectic_field(model.dynamics());
+  const physics::VectorField riemann = riemann_field(model.dynamics(), sign);
+  const Start start = choose_start(model, data, o.trajectory, sign);
   const auto points = [&](double duration) {
     return std::max(2, int(std::lround(duration / o.dt)) + 1);
   };
   std::vector<Phase> phases;
-  phases.push_back(integrate_phase("symplectic", symplectic, z0, o.before, points(o.before)));
+  phases.push_back(integrate_phase("symplectic", symplectic, start.z0, o.before, points(o.before)));
   const physics::Batch z1 = phases[0].z.bottomRows(1);
-  double duration = std::abs(o.riemann);
-  if (o.riemann == 0) {  // find the time at which H has risen (or fallen) by raise x spread
-    const double h1 = model.energy(z1)(0, 0);
-    const double spread = h_firsts.maxCoeff() - h_firsts.minCoeff();
-    HNN_TASKS_CHECK(spread > 0,
-                    "bump: --raise is a fraction of the spread of H over the test trials, and {} "
-                    "test trial(s) have none; give --riemann instead",
-                    h_firsts.size());
-    const double target = h1 + o.raise * spread;
-    const Phase probe = integrate_phase("riemann", riemann, z1, kMaxRiemannTime, kProbePoints);
-    const Eigen::VectorXd h = model.energy(probe.z).col(0);
-    duration = kMaxRiemannTime;
-    for (Eigen::Index k = 1; k < h.size(); ++k) {
-      if ((h(k) - target) * sign >= 0) {  // crossed: interpolate the time linearly
-        const double f = (target - h(k - 1)) / (h(k) - h(k - 1));
-        duration = probe.t[std::size_t(k) - 1] +
-                   f * (probe.t[std::size_t(k)] - probe.t[std::size_t(k) - 1]);
-        break;
-      }
-    }
-    HNN_TASKS_CHECK(duration < kMaxRiemannTime,
-                    "bump: H did not change by {} x its spread within {} time units along R_H",
-                    o.raise, kMaxRiemannTime);
-  }
+  const double duration =
+      o.riemann != 0 ? std::abs(o.riemann)
+                     : riemann_time_for_raise(model, riemann, z1, start.h_firsts, o.raise, sign);
   phases.push_back(
       integrate_phase("riemann", riemann, z1, std::max(duration, 1e-9), kRiemannPoints));
   phases.push_back(integrate_phase("symplectic-after", symplectic, phases[1].z.bottomRows(1),
                                    o.after, points(o.after)));
-
-  BumpResult result;
-  result.trajectory = trajectory;
-  result.riemann_time = duration;
-  std::string csv = "phase,t,z_q,z_p,learned_h,theta,p,energy\n";
-  std::vector<GrayImage> images;
-  std::vector<double> h_before, h_after, e_before, e_after;
-  double amp_before = 0, amp_after = 0, t0 = 0;
+  Record r;
+  double t0 = 0;
   for (std::size_t ph = 0; ph < phases.size(); ++ph) {
-    const Phase& p = phases[ph];
-    const Eigen::VectorXd h = model.energy(p.z).col(0);
-    const physics::Batch pairs = model.decode(p.z);
-    const physics::Batch next = model.decode(one_frame_later(symplectic, p.z));
-    for (Eigen::Index k = (ph == 0 ? 0 : 1); k < p.z.rows(); ++k) {  // phases share endpoints
-      const Eigen::RowVector2d x =
-          state_from_frames(scene, pairs.row(k).head(kFramePixels), next.row(k).head(kFramePixels));
-      const double e = scene.energy(x);
-      csv += fmt::format("{},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g}\n", p.name,
-                         t0 + p.t[std::size_t(k)], p.z(k, 0), p.z(k, 1), h(k), x(0), x(1), e);
-      if (ph == 0) {
-        h_before.push_back(h(k));
-        e_before.push_back(e);
-        amp_before = std::max(amp_before, std::abs(x(0)));
-      } else if (ph == 2) {
-        h_after.push_back(h(k));
-        e_after.push_back(e);
-        amp_after = std::max(amp_after, std::abs(x(0)));
-      }
-      GrayImage image(kSide * kScale + 2 * kGap, kSide * kScale + 2 * kGap,
-                      ph == 1 ? 128 : 64);  // a lighter border while R_H is integrated
-      draw_frame(image, kGap, kGap, pairs.row(k).tail(kFramePixels).cast<float>(), kSide, kScale,
-                 physics::GymPendulum::kIntensity);
-      images.push_back(std::move(image));
-    }
-    t0 += p.t.back();
+    record_phase(model, symplectic, phases[ph], ph, t0, r);
+    t0 += phases[ph].t.back();
   }
-  result.h_before = mean_of(h_before);
-  result.h_after = mean_of(h_after);
-  result.energy_before = mean_of(e_before);
-  result.energy_after = mean_of(e_after);
-  result.amplitude_before = amp_before;
-  result.amplitude_after = amp_after;
-
-  if (!o.out.empty()) {
-    fs::create_directories(o.out);
-    write_file_atomic(o.out / "bump.csv", csv);
-    write_gif(o.out / "bump.gif", images, 5);
-    // The strip: every 4th image, in one row.
-    const int stride = 4, tile = kSide * kScale + 2 * kGap;
-    const int cols = int((images.size() - 1) / stride) + 1;
-    GrayImage strip(cols * tile, tile, 64);
-    for (int c = 0; c < cols; ++c) {
-      const GrayImage& img = images[std::size_t(c * stride)];
-      for (int y = 0; y < img.height; ++y)
-        for (int x = 0; x < img.width; ++x) strip.at(c * tile + x, y) = img.at(x, y);
-    }
-    write_png(o.out / "bump_strip.png", strip);
-    result.files = {o.out / "bump.csv", o.out / "bump.gif", o.out / "bump_strip.png"};
-  }
+  BumpResult result{.trajectory = start.trajectory,
+                    .riemann_time = duration,
+                    .h_before = mean_of(r.h[0]),
+                    .h_after = mean_of(r.h[2]),
+                    .energy_before = mean_of(r.energy[0]),
+                    .energy_after = mean_of(r.energy[2]),
+                    .amplitude_before = r.amplitude[0],
+                    .amplitude_after = r.amplitude[2]};
+  if (!o.out.empty()) result.files = write_bump_files(r, o.out);
   return result;
 }
 

@@ -28,7 +28,7 @@ struct BumpResult {
   double h_before = 0, h_after = 0;                  // learned H in each S_H phase (mean)
   double energy_before = 0, energy_after = 0;        // true energy recovered from decoded frames
   double amplitude_before = 0, amplitude_after = 0;  // max |theta| of the decoded frames
-  std::vector<std::filesystem::path> files;
+  std::vector<std::filesystem::path> files{};
 };
 /// Writes bump.csv (phase,t,z_q,z_p,learned_h,theta,p,energy), bump.gif and bump_strip.png.
 /// theta, p and energy: state_from_frames of the decoded state and of the state one frame later

@@ -24,14 +24,14 @@ namespace hnn::tasks {
 
 /// The part of a checkpoint that is not matrices.
 struct TrainState {
-  long step = 0;                  // steps completed
-  long total_steps = 0;           // steps the run was asked for
-  std::string sampler_state;      // the minibatch std::mt19937_64, written with operator<<
-  std::uint64_t data_hash = 0;    // fingerprint of the training data (data_fingerprint)
-  std::vector<CurvePoint> curve;  // the loss curve up to `step`
-  double seconds = 0;             // training time so far
-  nlohmann::json run;             // the run's settings, for `hnn train --resume`
-  std::string params_file;        // the .bin holding the matrices (a name inside the folder)
+  long step = 0;                    // steps completed
+  long total_steps = 0;             // steps the run was asked for
+  std::string sampler_state{};      // the sampler's generator (and order), RowSampler::state
+  std::uint64_t data_hash = 0;      // fingerprint of the training data (Objective)
+  std::vector<CurvePoint> curve{};  // the loss curve up to `step`
+  double seconds = 0;               // training time so far
+  nlohmann::json run{};             // the run's settings, for `hnn train --resume`
+  std::string params_file{};        // the .bin holding the matrices (a name inside the folder)
 };
 
 /// Writes a checkpoint of `state.step` into `dir` (creating it), following Note [Checkpoint

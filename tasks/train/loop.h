@@ -16,7 +16,7 @@
 namespace hnn::tasks {
 
 struct TrainResult {
-  std::vector<CurvePoint> curve;
+  std::vector<CurvePoint> curve{};
   double seconds = 0;  // the training steps only (no data, no loss-curve points, no evaluation)
   long steps = 0;
 };
