@@ -102,29 +102,49 @@ std::vector<std::string> table_notes(const std::vector<std::string>& tasks) {
 
 }  // namespace
 
-json reproduce(const ReproduceOptions& o) {
-  HNN_TASKS_CHECK(o.seeds >= 1, "--seeds must be at least 1, got {}", o.seeds);
-  HNN_TASKS_CHECK(o.jobs >= 1, "--jobs must be at least 1, got {}", o.jobs);
-  const std::vector<std::string> tasks = o.tasks.empty() ? task_names() : o.tasks;
+namespace {
+
+// Every (task, model, seed) run, each checked before any work.
+std::vector<RunOptions> plan_runs(const ReproduceOptions& o,
+                                  const std::vector<std::string>& tasks) {
   std::vector<RunOptions> runs;
   for (const std::string& task : tasks) {
-    make_task(task);  // fail on a bad name before any work
     for (const nn::ModelKind model : kModels) {
       for (int seed = 0; seed < o.seeds; ++seed) {
-        RunOptions r;
-        r.task = task;
-        r.model = model;
-        r.seed = std::uint64_t(seed);
-        r.dtype = o.dtype;
-        r.preset = o.preset;
-        r.steps = o.steps;
-        r.threads = std::max(1, int(std::thread::hardware_concurrency()) / o.jobs);
-        r.out = run_dir(o, task, model, seed);
-        r.quiet = true;
+        RunOptions r{.task = task,
+                     .model = model,
+                     .seed = std::uint64_t(seed),
+                     .dtype = o.dtype,
+                     .preset = o.preset,
+                     .threads = std::max(1, int(std::thread::hardware_concurrency()) / o.jobs),
+                     .steps = o.steps,
+                     .out = run_dir(o, task, model, seed),
+                     .quiet = true};
+        validate(r);
         runs.push_back(r);
       }
     }
   }
+  return runs;
+}
+
+// table1.json: one row per task and model, the seeds' results averaged.
+json table_of(const std::vector<RunOptions>& runs, const std::vector<json>& results, int seeds) {
+  json table = json::array();
+  for (std::size_t i = 0; i < runs.size(); i += std::size_t(seeds)) {
+    const std::vector<json> rows(results.begin() + long(i), results.begin() + long(i) + seeds);
+    table.push_back(table_row(*make_task(runs[i].task), runs[i].model, rows));
+  }
+  return table;
+}
+
+}  // namespace
+
+json reproduce(const ReproduceOptions& o) {
+  HNN_TASKS_CHECK(o.seeds >= 1, "--seeds must be at least 1, got {}", o.seeds);
+  HNN_TASKS_CHECK(o.jobs >= 1, "--jobs must be at least 1, got {}", o.jobs);
+  const std::vector<std::string> tasks = o.tasks.empty() ? task_names() : o.tasks;
+  const std::vector<RunOptions> runs = plan_runs(o, tasks);
   fs::create_directories(o.out);
   fmt::print(stderr, "reproduce: {} runs on {} thread(s) into {}\n", runs.size(), o.jobs,
              o.out.string());
@@ -132,12 +152,7 @@ json reproduce(const ReproduceOptions& o) {
   const std::vector<json> results = run_all(runs, o.jobs);
   const double wall =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-
-  json table = json::array();
-  for (std::size_t i = 0; i < runs.size(); i += std::size_t(o.seeds)) {
-    const std::vector<json> seeds(results.begin() + long(i), results.begin() + long(i) + o.seeds);
-    table.push_back(table_row(*make_task(runs[i].task), runs[i].model, seeds));
-  }
+  const json table = table_of(runs, results, o.seeds);
   write_file_atomic(o.out / "table1.json", table.dump(2) + "\n");
   write_file_atomic(o.out / "table1.md", table1_markdown(table, wall, table_notes(tasks)));
   // What the HNN makes possible: the tasks' comparison figures, and reversibility on every run.

@@ -66,58 +66,76 @@ double amplitude_ratio(const Eigen::MatrixXd& theta) {
 
 }  // namespace
 
-json evaluate_pixel_model(const PixelModel<double>& model, const PixelData& data,
-                          const PixelConfig& config, const RunFolder* folder) {
-  const auto start = std::chrono::steady_clock::now();
-  const PixelLossStats train = pixel_loss_stats(model, data, false, config.hnn_weight);
-  const PixelLossStats test = pixel_loss_stats(model, data, true, config.hnn_weight);
-  const PixelRollouts r = pixel_rollouts(model, data, config, 2);
-  const nn::MeanStderr energy = pixel_energy_mse(r);
-  const nn::MeanStderr floor = pixel_energy_mse(r, EnergySource::kTrueFrames);
-  const nn::MeanStderr within_pair = pixel_energy_mse(r, EnergySource::kWithinPair);
-  Eigen::VectorXd frame_mse = Eigen::VectorXd::Zero(Eigen::Index(r.t.size()));
+namespace {
+
+// The decoded pairs' MSE at each time, over the rollouts that did not fail.
+Eigen::VectorXd mean_frame_mse(const PixelRollouts& r) {
+  Eigen::VectorXd mse = Eigen::VectorXd::Zero(Eigen::Index(r.t.size()));
   int used = 0;
   for (Eigen::Index i = 0; i < r.frame_mse.rows(); ++i) {
     if (r.failed[std::size_t(i)]) continue;
-    frame_mse += r.frame_mse.row(i).transpose();
+    mse += r.frame_mse.row(i).transpose();
     ++used;
   }
-  frame_mse /= std::max(used, 1);
+  return mse / std::max(used, 1);
+}
+
+json loss_metrics(const PixelLossStats& train, const PixelLossStats& test) {
   const auto terms = [](const PixelLossStats& s) {
     return json{{"ae", stats_json(s.ae)}, {"cc", stats_json(s.cc)}, {"hnn", stats_json(s.hnn)}};
   };
-  json m = {{"train_loss", number(train.total.mean)},
-            {"train_loss_se", number(train.total.std_error)},
-            {"test_loss", number(test.total.mean)},
-            {"test_loss_se", number(test.total.std_error)},
-            {"energy_mse", number(energy.mean)},
-            {"energy_mse_se", number(energy.std_error)},
-            {"n_rollouts", energy.count},
-            {"rollout_failures", r.failures},
-            {"n_train", data.train_rows()},
-            {"n_test", data.test_rows},
-            {"loss_terms", {{"train", terms(train)}, {"test", terms(test)}}},
-            {"energy_mse_frames_floor", number(floor.mean)},
-            {"energy_mse_within_pair", number(within_pair.mean)},
-            {"energy_mse_within_pair_se", number(within_pair.std_error)},
-            {"frame_mse_mean", number(frame_mse.mean())},
-            {"frame_mse_first", number(frame_mse(0))},
-            {"frame_mse_last", number(frame_mse(frame_mse.size() - 1))},
-            {"amplitude_ratio", number(amplitude_ratio(r.pred_theta))},
-            {"amplitude_ratio_true", number(amplitude_ratio(r.true_theta))},
-            {"rollout_frames", config.rollout_frames},
-            {"rollout_nfev", r.nfev}};
-  if (folder) {
-    folder->write_text("pixel_rollout.csv", rollout_csv(r));
-    write_latent_files(model, data, *folder);
-    if (!r.true_frames.empty()) {
-      std::vector<std::vector<const Eigen::MatrixXf*>> grid;
-      for (std::size_t i = 0; i < r.true_frames.size(); ++i)
-        grid.push_back({&r.true_frames[i], &r.pred_frames[i]});
-      write_animation(folder->file("rollout.gif"), grid);
-      write_strip(folder->file("rollout_strip.png"), {&r.true_frames[0], &r.pred_frames[0]}, 10);
-    }
-  }
+  return {{"train_loss", number(train.total.mean)},
+          {"train_loss_se", number(train.total.std_error)},
+          {"test_loss", number(test.total.mean)},
+          {"test_loss_se", number(test.total.std_error)},
+          {"loss_terms", {{"train", terms(train)}, {"test", terms(test)}}}};
+}
+
+json rollout_metrics(const PixelRollouts& r, const PixelConfig& config) {
+  const nn::MeanStderr energy = pixel_energy_mse(r);
+  const nn::MeanStderr within_pair = pixel_energy_mse(r, EnergySource::kWithinPair);
+  const Eigen::VectorXd frame_mse = mean_frame_mse(r);
+  return {{"energy_mse", number(energy.mean)},
+          {"energy_mse_se", number(energy.std_error)},
+          {"n_rollouts", energy.count},
+          {"rollout_failures", r.failures},
+          {"energy_mse_frames_floor", number(pixel_energy_mse(r, EnergySource::kTrueFrames).mean)},
+          {"energy_mse_within_pair", number(within_pair.mean)},
+          {"energy_mse_within_pair_se", number(within_pair.std_error)},
+          {"frame_mse_mean", number(frame_mse.mean())},
+          {"frame_mse_first", number(frame_mse(0))},
+          {"frame_mse_last", number(frame_mse(frame_mse.size() - 1))},
+          {"amplitude_ratio", number(amplitude_ratio(r.pred_theta))},
+          {"amplitude_ratio_true", number(amplitude_ratio(r.true_theta))},
+          {"rollout_frames", config.rollout_frames},
+          {"rollout_nfev", r.nfev}};
+}
+
+// pixel_rollout.csv, the latent files, and the first rollouts as GIF and strip.
+void write_pixel_files(const PixelModel<double>& model, const PixelData& data,
+                       const PixelRollouts& r, const RunFolder& folder) {
+  folder.write_text("pixel_rollout.csv", rollout_csv(r));
+  write_latent_files(model, data, folder);
+  if (r.true_frames.empty()) return;
+  std::vector<std::vector<const Eigen::MatrixXf*>> grid;
+  for (std::size_t i = 0; i < r.true_frames.size(); ++i)
+    grid.push_back({&r.true_frames[i], &r.pred_frames[i]});
+  write_animation(folder.file("rollout.gif"), grid);
+  write_strip(folder.file("rollout_strip.png"), {&r.true_frames[0], &r.pred_frames[0]}, 10);
+}
+
+}  // namespace
+
+json evaluate_pixel_model(const PixelModel<double>& model, const PixelData& data,
+                          const PixelConfig& config, const RunFolder* folder) {
+  const auto start = std::chrono::steady_clock::now();
+  json m = loss_metrics(pixel_loss_stats(model, data, false, config.hnn_weight),
+                        pixel_loss_stats(model, data, true, config.hnn_weight));
+  const PixelRollouts r = pixel_rollouts(model, data, config, 2);
+  m.update(rollout_metrics(r, config));
+  m["n_train"] = data.train_rows();
+  m["n_test"] = data.test_rows;
+  if (folder) write_pixel_files(model, data, r, *folder);
   m["eval_seconds"] = seconds_since(start);
   return m;
 }

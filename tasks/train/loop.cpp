@@ -187,55 +187,97 @@ double train_step(long step, Objective<T>& objective, GroupedAdam<T>& adam,
   return value;
 }
 
+// One run of the loop: the optimisers, the checkpoints, the loss curve so far and the clock.
+template <typename T>
+class Loop {
+ public:
+  Loop(Objective<T>& objective, const LoopOptions& o)
+      : objective_(objective),
+        o_(o),
+        adam_(objective.parameter_groups()),
+        checkpoints_(o, objective.data_fingerprint()) {
+    check_groups(objective, adam_.parameters());
+  }
+
+  /// The first step to take: 1, or the one after the checkpoint when resuming.
+  long start() {
+    long first = 1;
+    double earlier = 0;  // training time before the checkpoint
+    if (o_.resume) {
+      const TrainState state = checkpoints_.restore(objective_, adam_);
+      result_.curve = state.curve;
+      earlier = state.seconds;
+      first = state.step + 1;
+    }
+    clock_ = TrainClock(earlier);  // from now: restoring is not training
+    return first;
+  }
+
+  double step(long step) {
+    return train_step(step, objective_, adam_, grads_, checkpoints_.where());
+  }
+
+  void record(long step, double loss) {
+    if (step % interval_ != 0 && step != o_.steps) return;
+    clock_.pause_for([&] {
+      result_.curve.push_back(objective_.curve_point(step, loss));
+      if (o_.on_record) o_.on_record(step);
+    });
+  }
+
+  void checkpoint(long step, bool stopping) {
+    if (!checkpoints_.due(step) && !(stopping && checkpoints_.enabled())) return;
+    result_.seconds = clock_.seconds();
+    clock_.pause_for([&] { checkpoints_.save(step, objective_, adam_, result_); });
+  }
+
+  [[noreturn]] void stopped(long step) const {
+    throw TrainingInterrupted(
+        fmt::format("training stopped at step {} of {}{}", step, o_.steps,
+                    checkpoints_.enabled() ? "; checkpoint in " + o_.checkpoint_dir.string() : ""),
+        step);
+  }
+
+  TrainResult finish() {
+    result_.seconds = clock_.seconds();
+    result_.steps = o_.steps;
+    return std::move(result_);
+  }
+
+ private:
+  Objective<T>& objective_;
+  const LoopOptions& o_;
+  GroupedAdam<T> adam_;
+  Checkpoints<T> checkpoints_;
+  const long interval_ = record_interval(o_);
+  TrainResult result_;
+  TrainClock clock_{0};
+  std::vector<ad::Var<T>> grads_;  // reused: a step allocates nothing in steady state
+};
+
 }  // namespace
 
 template <typename T>
 TrainResult train(Objective<T>& objective, const LoopOptions& o) {
   HNN_TASKS_CHECK(o.steps > 0, "steps must be positive, got {}", o.steps);
-  GroupedAdam<T> adam(objective.parameter_groups());
-  check_groups(objective, adam.parameters());
-  Checkpoints<T> checkpoints(o, objective.data_fingerprint());
-  TrainResult result;
-  long first = 1;
-  double earlier_seconds = 0;
-  if (o.resume) {
-    const TrainState state = checkpoints.restore(objective, adam);
-    first = state.step + 1;
-    result.curve = state.curve;
-    earlier_seconds = state.seconds;
-  }
+  Loop<T> loop(objective, o);
+  const long first = loop.start();
   Progress progress(o.label, o.steps, o.quiet);
-  TrainClock clock(earlier_seconds);
-  const long interval = record_interval(o);
   const ArmStop arm(o.stop);
-  std::vector<ad::Var<T>> grads;  // reused: a step allocates nothing in steady state
   double loss = 0;
   for (long step = first; step <= o.steps; ++step) {
-    loss = train_step(step, objective, adam, grads, checkpoints.where());
-    if (step % interval == 0 || step == o.steps) {
-      clock.pause_for([&] {
-        result.curve.push_back(objective.curve_point(step, loss));
-        if (o.on_record) o.on_record(step);
-      });
-    }
+    loss = loop.step(step);
+    loop.record(step, loss);
     const bool stop = o.stop && o.stop->requested && step < o.steps;
-    if (checkpoints.due(step) || (stop && checkpoints.enabled())) {
-      result.seconds = clock.seconds();
-      clock.pause_for([&] { checkpoints.save(step, objective, adam, result); });
-    }
+    loop.checkpoint(step, stop);
     progress.update(step, loss);
     if (stop) {
       progress.stop(step, loss);
-      throw TrainingInterrupted(
-          fmt::format("training stopped at step {} of {}{}", step, o.steps,
-                      checkpoints.enabled() ? "; checkpoint in " + o.checkpoint_dir.string() : ""),
-          step);
+      loop.stopped(step);
     }
   }
-  result.seconds = clock.seconds();
-  result.steps = o.steps;
   progress.finish(loss);
-  return result;
+  return loop.finish();
 }
 
 template TrainResult train(Objective<float>&, const LoopOptions&);
