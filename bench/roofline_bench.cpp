@@ -115,7 +115,7 @@ constexpr StepShape kShapes[] = {{"spring", 750, 2}, {"two-body", 200, 8}, {"thr
 constexpr long kWidth = 200;
 
 // FLOPs of one HNN step (fused forward, input gradient and their backward: see the derivation
-// at the top of autodiff/ops_mlp.cpp) or baseline step (forward and backward), with two hidden
+// at the top of autodiff/mlp_kernels.cpp) or baseline step (forward and backward), with two hidden
 // layers of width n. GEMM m x n x k counts 2mnk.
 double step_flops(const StepShape& s, nn::ModelKind kind) {
   const double R = double(s.rows), d = double(s.dim), n = kWidth;
