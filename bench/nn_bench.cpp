@@ -38,11 +38,13 @@ Data spring_data() {
 }
 
 template <typename T>
-void training_step(benchmark::State& state, nn::ModelKind kind) {
+void training_step(benchmark::State& state, nn::ModelKind kind,
+                   nn::FieldType field = nn::FieldType::kSolenoidal) {
   ad::set_num_threads(int(state.range(0)));
   const Data data = spring_data();
   nn::DynamicsConfig config;  // the paper's: 2-200-200-out, tanh, orthogonal
   config.model = kind;
+  config.field = field;
   std::mt19937_64 rng(1);
   const auto model = nn::make_model<T>(config, rng);
   nn::Adam<T> adam(model->parameters(), {.lr = 1e-3, .weight_decay = 1e-4});
@@ -64,6 +66,12 @@ void training_step(benchmark::State& state, nn::ModelKind kind) {
 template <typename T>
 void BM_HnnStep(benchmark::State& state) {
   training_step<T>(state, nn::ModelKind::kHnn);
+}
+
+// The dissipative HNN (H and D from one MLP, field S_H + grad D): two fused input gradients.
+template <typename T>
+void BM_DissipativeHnnStep(benchmark::State& state) {
+  training_step<T>(state, nn::ModelKind::kHnn, nn::FieldType::kBoth);
 }
 
 template <typename T>
@@ -91,6 +99,18 @@ BENCHMARK(BM_HnnStep<float>)
     ->Arg(2)
     ->UseRealTime();
 BENCHMARK(BM_HnnStep<double>)
+    ->Unit(benchmark::kMillisecond)
+    ->ArgName("threads")
+    ->Arg(1)
+    ->Arg(2)
+    ->UseRealTime();
+BENCHMARK(BM_DissipativeHnnStep<float>)
+    ->Unit(benchmark::kMillisecond)
+    ->ArgName("threads")
+    ->Arg(1)
+    ->Arg(2)
+    ->UseRealTime();
+BENCHMARK(BM_DissipativeHnnStep<double>)
     ->Unit(benchmark::kMillisecond)
     ->ArgName("threads")
     ->Arg(1)

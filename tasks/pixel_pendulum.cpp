@@ -3,6 +3,9 @@
 
 #include "tasks/pixel_pendulum.h"
 
+#include <fmt/ranges.h>
+
+#include <algorithm>
 #include <variant>
 
 #include "nn/checkpoint.h"
@@ -21,6 +24,17 @@ using pixel::PixelModel;
 // The settings every task has are the training settings; the task's own are the rest.
 constexpr const char* kTrainKeys[] = {"steps", "batch_size", "learning_rate", "weight_decay",
                                       "hidden"};
+
+// PixelConfig's keys but the training settings.
+std::vector<std::string> task_setting_names() {
+  std::vector<std::string> names;
+  const nlohmann::json defaults = PixelConfig{}.to_json();  // items() refers to it
+  for (const auto& [key, value] : defaults.items()) {
+    if (std::find(std::begin(kTrainKeys), std::end(kTrainKeys), key) == std::end(kTrainKeys))
+      names.push_back(key);
+  }
+  return names;
+}
 
 PixelConfig pixel_config(const RunSettings& s) {
   nlohmann::json j = PixelConfig{}.to_json();
@@ -157,7 +171,7 @@ class PixelPendulumTask : public Task {
            "trials (see energy_mse_frames_floor in its metrics.json for the recovery's own error).";
   }
   void check_task_settings(const nlohmann::json& settings) const override {
-    const nlohmann::json known = PixelConfig{}.to_json();
+    const std::vector<std::string> known = task_setting_names();
     for (const auto& [key, value] : settings.items()) {
       for (const char* train_key : kTrainKeys) {
         HNN_TASKS_CHECK(key != train_key,
@@ -165,8 +179,9 @@ class PixelPendulumTask : public Task {
                         "(--steps, --batch, --lr, --hidden), not a task setting",
                         key);
       }
-      HNN_TASKS_CHECK(known.contains(key), "pixel-pendulum has no setting '{}' (known: {})", key,
-                      known.dump());
+      HNN_TASKS_CHECK(std::find(known.begin(), known.end(), key) != known.end(),
+                      "pixel-pendulum has no setting '{}' (known: {})", key,
+                      fmt::join(known, ", "));
     }
   }
   std::unique_ptr<TaskRun> open(const RunSettings& settings) const override {

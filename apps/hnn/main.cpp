@@ -67,7 +67,7 @@ void train_until_done_or_stopped(tasks::RunOptions o) {
 // the result may be given again.
 tasks::RunOptions resumed_options(const CLI::App& cmd, const std::string& dir, bool quiet) {
   for (const char* name : {"task", "--model", "--steps", "--seed", "--dtype", "--preset", "--batch",
-                           "--hidden", "--lr", "--data", "--out"}) {
+                           "--hidden", "--lr", "--data", "--settings", "--out"}) {
     if (cmd.get_option(name)->count() > 0) {
       throw std::invalid_argument(fmt::format(
           "{} cannot be combined with --resume: a resumed run keeps its own settings", name));
@@ -80,6 +80,16 @@ tasks::RunOptions resumed_options(const CLI::App& cmd, const std::string& dir, b
     o.checkpoint_every = cmd.get_option("--checkpoint-every")->as<long>();
   }
   return o;
+}
+
+// --settings: a JSON object, or one line saying why not.
+nlohmann::json task_settings(const std::string& text) {
+  const nlohmann::json j = nlohmann::json::parse(text, nullptr, /*allow_exceptions=*/false);
+  if (!j.is_object()) {
+    throw std::invalid_argument(
+        fmt::format("--settings must be a JSON object like '{{\"trials\": 20}}', got '{}'", text));
+  }
+  return j;
 }
 
 }  // namespace
@@ -124,6 +134,10 @@ void add_train_command(CLI::App& app) {
                   "A measured-data file of the same format (real-pendulum)");
   cmd->add_option("--out", options->out, "Run folder (default runs/TASK/MODEL)");
   cmd->add_flag("--quiet", options->quiet, "No progress output");
+  auto settings = std::make_shared<std::string>();
+  cmd->add_option("--settings", *settings,
+                  "The task's own settings as a JSON object, e.g. pixel-pendulum's "
+                  "'{\"trials\": 20, \"ae_hidden\": 64}' (see its metrics.json's \"pixel\")");
   cmd->add_option("--checkpoint-every", *checkpoint_every,
                   "Steps between checkpoints in OUT/checkpoint (default: a tenth of the steps)")
       ->check(positive_integer());
@@ -138,6 +152,7 @@ void add_train_command(CLI::App& app) {
     o.model = tasks::parse_model(*model);
     o.dtype = tasks::parse_dtype(*dtype);
     o.preset = tasks::parse_preset(*preset);
+    if (!settings->empty()) o.task_settings = task_settings(*settings);
     if (*steps > 0) o.steps = *steps;
     if (*batch >= 0) o.batch_size = *batch;
     if (*lr > 0) o.learning_rate = *lr;

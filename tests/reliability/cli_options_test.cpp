@@ -50,6 +50,19 @@ std::vector<BadOption> bad_train_options() {
       {{"train", "spring", "--data", "x.txt"},
        "task 'spring' does not read a data file (--data applies to measured-data tasks such as "
        "real-pendulum)"},
+      {{"train", "spring", "--settings", "{\"trials\": 20}"},
+       "task 'spring' has no settings of its own, got {\"trials\":20}"},
+      {{"train", "pixel-pendulum", "--settings", "[20]"},
+       "--settings must be a JSON object like '{\"trials\": 20}', got '[20]'"},
+      {{"train", "pixel-pendulum", "--settings", "{\"trials\": 1}"},
+       "pixel-pendulum: trials must be at least 2, got 1"},
+      {{"train", "pixel-pendulum", "--settings", "{\"trails\": 20}"},
+       "pixel-pendulum has no setting 'trails' (known: ae_hidden, atol, dynamics_weight_decay, "
+       "frames_per_trial, hnn_weight, rollout_frames, rollout_trials, rtol, test_fraction, "
+       "trials)"},
+      {{"train", "pixel-pendulum", "--settings", "{\"steps\": 20}"},
+       "pixel-pendulum: 'steps' is a training setting: give it as an option (--steps, --batch, "
+       "--lr, --hidden), not a task setting"},
       {{"train", "spring", "--bogus"}, "The following argument was not expected: --bogus"},
       {{"train"}, "train needs a TASK (or --resume DIR)"},
   };
