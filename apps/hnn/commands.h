@@ -9,7 +9,8 @@ void add_train_command(CLI::App& app);
 void add_evaluate_command(CLI::App& app);
 void add_rollout_command(CLI::App& app);
 void add_reproduce_command(CLI::App& app);
-/// bump, animate and reversibility (apps/hnn/pixel_commands.cpp).
-void add_pixel_commands(CLI::App& app);
+/// bump and animate (the pixel pendulum's Figures 5 and 4) and reversibility (any run):
+/// apps/hnn/analysis_commands.cpp.
+void add_analysis_commands(CLI::App& app);
 
 }  // namespace hnn::app

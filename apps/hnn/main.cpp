@@ -225,7 +225,7 @@ int main(int argc, char** argv) {
   hnn::app::add_evaluate_command(app);
   hnn::app::add_rollout_command(app);
   hnn::app::add_reproduce_command(app);
-  hnn::app::add_pixel_commands(app);
+  hnn::app::add_analysis_commands(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::RuntimeError& e) {

@@ -135,7 +135,7 @@ void add_reversibility_command(CLI::App& app) {
 
 }  // namespace
 
-void add_pixel_commands(CLI::App& app) {
+void add_analysis_commands(CLI::App& app) {
   add_bump_command(app);
   add_animate_command(app);
   add_reversibility_command(app);
