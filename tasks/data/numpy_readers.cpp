@@ -1,0 +1,236 @@
+// The NumPy readers: xtensor parses each .npy array (header and data), libzip opens .npz
+// archives. The header is parsed and checked (dtype, rank, size against the bytes present)
+// before xtensor allocates the data, so a corrupt shape cannot ask for terabytes.
+#include <zip.h>
+
+#include <memory>
+#include <sstream>
+#include <xtensor/xnpy.hpp>
+
+#include "tasks/data/reader_util.h"
+#include "tasks/data/table.h"
+#include "tasks/error.h"
+
+namespace hnn::tasks {
+
+namespace {
+
+// One array as columns: a 1-D array is one column.
+struct Array {
+  std::vector<std::size_t> shape;
+  Eigen::MatrixXd columns;
+};
+
+struct NpyHeader {
+  std::string descr;
+  bool fortran_order = false;
+  std::vector<std::size_t> shape;
+  std::size_t data_offset = 0;
+};
+
+std::string shape_text(const std::vector<std::size_t>& shape) {
+  std::string text;
+  for (std::size_t d : shape) text += (text.empty() ? "" : "x") + std::to_string(d);
+  return shape.empty() ? "a scalar" : text;
+}
+
+// The header's length field (little endian, 2 bytes in format 1.x, 4 in 2.x and 3.x), read here
+// only to check that the header and the data fit in the bytes present.
+std::size_t header_length(const std::string& bytes, int width) {
+  std::size_t length = 0;
+  for (int k = width - 1; k >= 0; --k)
+    length = length * 256 + static_cast<unsigned char>(bytes[8 + k]);
+  return length;
+}
+
+NpyHeader read_npy_header(const std::string& bytes, const std::string& where) {
+  HNN_TASKS_CHECK(bytes.size() >= 10 && bytes.compare(0, 6, "\x93NUMPY") == 0,
+                  "{}: not a NumPy .npy array (it does not start with \\x93NUMPY)", where);
+  const int width = bytes[6] == 1 ? 2 : 4;
+  const std::size_t length = header_length(bytes, width);
+  HNN_TASKS_CHECK(length > 0 && 8 + width + length <= bytes.size(),
+                  "{}: truncated: the .npy header claims {} bytes but the file has {}", where,
+                  length, bytes.size());
+  NpyHeader header;
+  header.data_offset = 8 + std::size_t(width) + length;
+  try {
+    xt::detail::parse_header(bytes.substr(8 + width, length), header.descr, &header.fortran_order,
+                             header.shape);
+  } catch (const std::exception& e) {
+    throw Error(fmt::format("{}: not a readable .npy header: {}", where, e.what()));
+  }
+  return header;
+}
+
+// Checks the dtype, rank and size before any allocation; returns the bytes per value.
+std::size_t check_npy_header(const NpyHeader& h, const std::string& bytes, const std::string& where,
+                             std::size_t min_rank) {
+  HNN_TASKS_CHECK(h.descr == "<f8" || h.descr == "<f4",
+                  "{}: holds '{}' values; only float64 ('<f8') and float32 ('<f4') are read", where,
+                  h.descr);
+  HNN_TASKS_CHECK(h.shape.size() >= min_rank && h.shape.size() <= 2,
+                  "{}: an array of shape {}; {} is needed", where, shape_text(h.shape),
+                  min_rank == 2 ? "a 2-D array (rows x columns)"
+                                : "a 1-D array (a column) or a 2-D array (columns)");
+  const std::size_t word = h.descr == "<f8" ? 8 : 4;
+  std::size_t expected = word;
+  for (std::size_t d : h.shape) {
+    HNN_TASKS_CHECK(d == 0 || expected <= bytes.size() / d,
+                    "{}: truncated: shape {} needs more bytes than the file's {}", where,
+                    shape_text(h.shape), bytes.size());
+    expected *= d;
+  }
+  const std::size_t present = bytes.size() - h.data_offset;
+  HNN_TASKS_CHECK(present == expected,
+                  "{}: {}: shape {} of '{}' needs {} bytes of data, but {} follow the header",
+                  where, present < expected ? "truncated" : "trailing bytes", shape_text(h.shape),
+                  h.descr, expected, present);
+  HNN_TASKS_CHECK(h.shape[0] > 0 && (h.shape.size() == 1 || h.shape[1] > 0),
+                  "{}: an empty array (shape {})", where, shape_text(h.shape));
+  return word;
+}
+
+template <typename T>
+Eigen::MatrixXd to_columns(xt::detail::npy_file&& file, const std::vector<std::size_t>& shape) {
+  const auto array = std::move(file).cast<T>();
+  const auto rows = Eigen::Index(shape[0]);
+  const auto cols = Eigen::Index(shape.size() == 2 ? shape[1] : 1);
+  Eigen::MatrixXd out(rows, cols);
+  for (Eigen::Index i = 0; i < rows; ++i) {
+    for (Eigen::Index j = 0; j < cols; ++j) {
+      out(i, j) = shape.size() == 2 ? double(array(std::size_t(i), std::size_t(j)))
+                                    : double(array(std::size_t(i)));
+    }
+  }
+  return out;
+}
+
+void check_finite(const Array& a, const std::string& where) {
+  for (Eigen::Index j = 0; j < a.columns.cols(); ++j) {
+    for (Eigen::Index i = 0; i < a.columns.rows(); ++i) {
+      const double v = a.columns(i, j);
+      if (std::isfinite(v)) continue;
+      if (a.shape.size() == 1)
+        throw Error(fmt::format("{}, row {}: {} is not finite", where, i, v));
+      throw Error(fmt::format("{}, row {}, column {}: {} is not finite", where, i, j, v));
+    }
+  }
+}
+
+// `where` names the file, or the file and the npz member.
+Array parse_npy(const std::string& bytes, const std::string& where, std::size_t min_rank) {
+  const NpyHeader header = read_npy_header(bytes, where);
+  const std::size_t word = check_npy_header(header, bytes, where, min_rank);
+  std::istringstream in(bytes);
+  Array array{header.shape, {}};
+  try {
+    xt::detail::npy_file file = xt::detail::load_npy_file(in);
+    array.columns = word == 8 ? to_columns<double>(std::move(file), header.shape)
+                              : to_columns<float>(std::move(file), header.shape);
+  } catch (const std::exception& e) {
+    throw Error(fmt::format("{}: not a readable .npy array: {}", where, e.what()));
+  }
+  check_finite(array, where);
+  return array;
+}
+
+struct ZipCloser {
+  void operator()(zip_t* archive) const { zip_discard(archive); }
+};
+using ZipArchive = std::unique_ptr<zip_t, ZipCloser>;
+
+ZipArchive open_zip(const std::string& path) {
+  int code = 0;
+  zip_t* archive = zip_open(path.c_str(), ZIP_RDONLY, &code);
+  if (archive == nullptr) {
+    zip_error_t error;
+    zip_error_init_with_code(&error, code);
+    const std::string reason = zip_error_strerror(&error);
+    zip_error_fini(&error);
+    throw Error(fmt::format("{}: not a readable .npz archive (libzip: {})", path, reason));
+  }
+  return ZipArchive(archive);
+}
+
+std::string read_member(zip_t* archive, zip_uint64_t index, const zip_stat_t& stat,
+                        const std::string& where) {
+  std::unique_ptr<zip_file_t, decltype(&zip_fclose)> file(zip_fopen_index(archive, index, 0),
+                                                          &zip_fclose);
+  HNN_TASKS_CHECK(file != nullptr, "{}: cannot open it in the archive (libzip: {})", where,
+                  zip_strerror(archive));
+  std::string bytes;
+  try {
+    bytes.resize(stat.size);
+  } catch (const std::exception&) {
+    throw Error(
+        fmt::format("{}: claims {} bytes, more than this machine can hold", where, stat.size));
+  }
+  const zip_int64_t got = zip_fread(file.get(), bytes.data(), stat.size);
+  HNN_TASKS_CHECK(got >= 0 && zip_uint64_t(got) == stat.size,
+                  "{}: cannot read it from the archive (libzip: {})", where,
+                  zip_file_strerror(file.get()));
+  return bytes;
+}
+
+// Adds a member's columns: "x" for a 1-D array, "x[0]", "x[1]", ... for a 2-D one.
+void add_columns(Table& table, const std::string& name, const Array& array,
+                 std::vector<Eigen::MatrixXd>& blocks, std::string& first) {
+  if (!blocks.empty()) {
+    HNN_TASKS_CHECK(array.columns.rows() == blocks[0].rows(),
+                    "{}: array '{}' has {} rows but array '{}' has {} (the arrays are the columns "
+                    "of one table and need one length)",
+                    table.source, name, array.columns.rows(), first, blocks[0].rows());
+  } else {
+    first = name;
+  }
+  for (Eigen::Index j = 0; j < array.columns.cols(); ++j) {
+    table.names.push_back(array.shape.size() == 1 ? name : fmt::format("{}[{}]", name, j));
+  }
+  blocks.push_back(array.columns);
+}
+
+}  // namespace
+
+Table read_npy(const std::string& path) {
+  const Array array = parse_npy(reader::read_bytes(path), path, 2);
+  Table table{path, TableFormat::kNpy, {}, {}, {}, {}};
+  for (Eigen::Index j = 0; j < array.columns.cols(); ++j) table.names.push_back(std::to_string(j));
+  table.values = array.columns;
+  return table;
+}
+
+Table read_npz(const std::string& path) {
+  reader::check_readable(path);
+  const ZipArchive archive = open_zip(path);
+  Table table{path, TableFormat::kNpz, {}, {}, {}, {}};
+  std::vector<Eigen::MatrixXd> blocks;
+  std::string first;
+  const zip_int64_t entries = zip_get_num_entries(archive.get(), 0);
+  for (zip_int64_t i = 0; i < entries; ++i) {
+    zip_stat_t stat;
+    HNN_TASKS_CHECK(zip_stat_index(archive.get(), zip_uint64_t(i), 0, &stat) == 0,
+                    "{}: member {} is unreadable (libzip: {})", path, i,
+                    zip_strerror(archive.get()));
+    const std::string member = stat.name;
+    if (!member.empty() && member.back() == '/') continue;  // a folder entry
+    HNN_TASKS_CHECK(member.size() > 4 && member.ends_with(".npy"),
+                    "{}: member '{}' is not a .npy array (an .npz holds name.npy members)", path,
+                    member);
+    const std::string name = member.substr(0, member.size() - 4);
+    const std::string where = fmt::format("{}: array '{}'", path, name);
+    add_columns(table, name,
+                parse_npy(read_member(archive.get(), zip_uint64_t(i), stat, where), where, 1),
+                blocks, first);
+  }
+  HNN_TASKS_CHECK(!blocks.empty(), "{}: the archive holds no arrays", path);
+  reader::check_unique_names(table.names, path);
+  table.values.resize(blocks[0].rows(), Eigen::Index(table.names.size()));
+  Eigen::Index column = 0;
+  for (const Eigen::MatrixXd& block : blocks) {
+    table.values.middleCols(column, block.cols()) = block;
+    column += block.cols();
+  }
+  return table;
+}
+
+}  // namespace hnn::tasks
