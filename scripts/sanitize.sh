@@ -11,6 +11,9 @@ scripts/setup.sh
 build_dir=${HNN_ASAN_BUILD_DIR:-build-asan}
 jobs=${HNN_JOBS:-$(nproc)}
 start=$(date +%s)
+# Third-party leaks (scripts/lsan.supp) are suppressed from the build on: gtest_discover_tests
+# runs each test program while building.
+export LSAN_OPTIONS=${LSAN_OPTIONS:-suppressions=$(pwd)/scripts/lsan.supp:print_suppressions=0}
 cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O2 -g1" \
   -DHNN_SANITIZE=ON -DHNN_BUILD_BENCH=OFF >/dev/null
 cmake --build "$build_dir" -j "$jobs"
