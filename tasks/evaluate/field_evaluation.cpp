@@ -12,6 +12,19 @@ namespace hnn::tasks {
 
 using nlohmann::json;
 
+namespace {
+
+// 1 - MSE / variance of the targets (over all components): the share of the targets' spread
+// the model explains, whatever the data's units.
+double r_squared(double mse, const Batch& dxdt) {
+  if (dxdt.rows() == 0) return NAN;
+  const Eigen::RowVectorXd mean = dxdt.colwise().mean();
+  const double variance = (dxdt.rowwise() - mean).squaredNorm() / double(dxdt.size());
+  return variance > 0 ? 1 - mse / variance : NAN;
+}
+
+}  // namespace
+
 FieldEvaluation evaluate_field_model(const physics::System& truth,
                                      const nn::DynamicsModel<double>& model, const Dataset& data,
                                      const Batch& x0, const RolloutConfig& config) {
@@ -25,6 +38,8 @@ FieldEvaluation evaluate_field_model(const physics::System& truth,
                {"energy_mse", number(energy.mean)}, {"energy_mse_se", number(energy.std_error)},
                {"n_rollouts", energy.count},        {"rollout_failures", e.rollouts.failures},
                {"n_train", data.train_x.rows()},    {"n_test", data.test_x.rows()}};
+  e.metrics["train_r2"] = number(r_squared(train.mean, data.train_dxdt));
+  e.metrics["test_r2"] = number(r_squared(test.mean, data.test_dxdt));
   e.metrics["eval_seconds"] =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return e;

@@ -13,7 +13,9 @@
 namespace hnn::tasks {
 
 struct FieldEvaluation {
-  nlohmann::json metrics{};  // train/test loss and energy MSE with standard errors, counts, time
+  /// Train/test loss and energy MSE with standard errors, R^2 of each split (1 - MSE / variance
+  /// of the targets), counts, time.
+  nlohmann::json metrics{};
   Rollouts rollouts{};
 };
 

@@ -9,6 +9,7 @@
 
 #include "nn/hnn.h"
 #include "physics/integrator.h"
+#include "tasks/evaluate/field_evaluation.h"
 #include "tasks/evaluate/rollouts.h"
 #include "tasks/field_task.h"
 #include "tasks/train/field_objective.h"
@@ -299,6 +300,43 @@ TEST(CoordinateMse, MeanOverSurvivingTrajectoriesAtEachTime) {
   r.failed[2] = true;
   mse = coordinate_mse_over_time(r);
   EXPECT_NEAR(mse(0), 0.5, 1e-12);
+}
+
+}  // namespace
+}  // namespace hnn::tasks
+
+namespace hnn::tasks {
+namespace {
+
+using nlohmann::json;
+
+// R^2 = 1 - MSE / variance of the targets: 1 for the exact field, 1 - E[y^2] / Var(y) for zero,
+// and the same whatever the units (the targets scaled by 100 scale MSE and variance alike).
+TEST(FieldEvaluation, RSquaredIsOneMinusMseOverTheTargetsVariance) {
+  const std::unique_ptr<FieldTask> task = make_field_task("spring");
+  const Dataset d = task->build_dataset(0);
+  const RolloutConfig few{.trajectories = 2, .t_end = 1.0, .points = 5};
+  const Batch x0 = d.test_x.topRows(2);
+  // The targets are the field at the clean states and the inputs are noisy: not exactly 1.
+  const json exact = evaluate_field_model(task->truth(), exact_model(*task), d, x0, few).metrics;
+  EXPECT_GT(exact["test_r2"].get<double>(), 0.9);
+  EXPECT_LT(exact["test_r2"].get<double>(), 1.0);
+  const json zero = evaluate_field_model(task->truth(), zero_model(2), d, x0, few).metrics;
+  const Eigen::RowVectorXd mean = d.test_dxdt.colwise().mean();
+  const double variance = (d.test_dxdt.rowwise() - mean).squaredNorm() / double(d.test_dxdt.size());
+  EXPECT_NEAR(zero["test_r2"].get<double>(),
+              1 - d.test_dxdt.squaredNorm() / double(d.test_dxdt.size()) / variance, 1e-12);
+  Dataset scaled = d;
+  scaled.test_dxdt *= 100;
+  const FunctionModel scaled_exact(2, [&task](const Batch& x) {
+    Batch dxdt;
+    task->truth().vector_field(x, dxdt);
+    return Batch(100 * dxdt);
+  });
+  EXPECT_NEAR(evaluate_field_model(task->truth(), scaled_exact, scaled, x0, few)
+                  .metrics["test_r2"]
+                  .get<double>(),
+              exact["test_r2"].get<double>(), 1e-12);
 }
 
 }  // namespace
