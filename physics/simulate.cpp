@@ -33,13 +33,14 @@ Trajectory integrate_system(const Integrator& integrator, const System& system, 
                             const std::vector<double>& t_eval) {
   const auto* splitting = dynamic_cast<const SplittingIntegrator*>(&integrator);
   if (splitting == nullptr) return integrator.integrate(system.field(), x0, t_eval);
-  const auto* separable = dynamic_cast<const SeparableSystem*>(&system);
-  if (separable == nullptr) {
-    throw std::invalid_argument(
-        fmt::format("{} needs a separable Hamiltonian; {} is not (use midpoint)", integrator.name(),
-                    system.name()));
+  const std::optional<SplitField> halves = system.separable_split();
+  if (!halves) {
+    throw std::invalid_argument(fmt::format(
+        "{} needs a separable Hamiltonian H = T(p) + V(q); {} is not: use midpoint (symplectic), "
+        "rk4 or dopri5",
+        integrator.name(), system.name()));
   }
-  return splitting->integrate(separable->split(), x0, t_eval);
+  return splitting->integrate(*halves, x0, t_eval);
 }
 
 }  // namespace hnn::physics

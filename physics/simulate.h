@@ -19,8 +19,9 @@ Trajectory simulate(const System& system, const Batch& x0, const std::vector<dou
                     const SimulateOptions& options = {});
 
 /// Integrates a system with any integrator. Splitting methods use the system's
-/// exact halves when it is separable (half the work of splitting the full
-/// field) and throw std::invalid_argument when it is not.
+/// exact halves (System::separable_split(): half the work of splitting the full
+/// field) and throw std::invalid_argument naming midpoint, rk4 and dopri5 when
+/// the system is not separable.
 Trajectory integrate_system(const Integrator& integrator, const System& system, const Batch& x0,
                             const std::vector<double>& t_eval);
 

@@ -10,6 +10,14 @@
 
 namespace hnn::physics {
 
+/// The two halves of a separable field, each given the whole state x = (q, p)
+/// and writing rows x dim/2: drift = dq/dt = dT/dp (depends on p only) and
+/// kick = dp/dt = -dV/dq (depends on q only).
+struct SplitField {
+  std::function<void(double t, const Batch& x, Batch& dq)> drift;
+  std::function<void(double t, const Batch& x, Batch& dp)> kick;
+};
+
 /// A Hamiltonian system in canonical coordinates x = (q, p). Implementations
 /// write each formula once, vectorised over the rows of a Batch.
 class System {
@@ -42,14 +50,10 @@ class System {
   /// system alive while the callable is in use. Throws std::invalid_argument on
   /// a batch whose column count is not dim().
   VectorField field() const;
-};
 
-/// The two halves of a separable field, each given the whole state x = (q, p)
-/// and writing rows x dim/2: drift = dq/dt = dT/dp (depends on p only) and
-/// kick = dp/dt = -dV/dq (depends on q only).
-struct SplitField {
-  std::function<void(double t, const Batch& x, Batch& dq)> drift;
-  std::function<void(double t, const Batch& x, Batch& dp)> kick;
+  /// The exact halves of the field when H = T(p) + V(q), for splitting methods; nullopt when
+  /// H is not separable (the default). Refers to *this, like field().
+  virtual std::optional<SplitField> separable_split() const { return std::nullopt; }
 };
 
 /// Splits a general field by evaluating it in full and keeping one half. Right
@@ -70,6 +74,7 @@ class SeparableSystem : public System {
   /// Exact halves for splitting integrators (each half costs only its own work).
   /// Refers to *this, like field().
   SplitField split() const;
+  std::optional<SplitField> separable_split() const override { return split(); }
 };
 
 }  // namespace hnn::physics
