@@ -12,5 +12,7 @@ void add_reproduce_command(CLI::App& app);
 /// bump and animate (the pixel pendulum's Figures 5 and 4) and reversibility (any run):
 /// apps/hnn/analysis_commands.cpp.
 void add_analysis_commands(CLI::App& app);
+/// simulate: trajectories of a Hamiltonian given as an expression (apps/hnn/simulate_command.cpp).
+void add_simulate_command(CLI::App& app);
 
 }  // namespace hnn::app
