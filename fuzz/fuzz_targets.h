@@ -19,6 +19,7 @@
 #include "nn/hnn.h"
 #include "physics/lipson.h"
 #include "physics/types.h"
+#include "tasks/data/table.h"
 #include "tasks/field_task.h"
 #include "tasks/report/run_folder.h"
 #include "tasks/run.h"
@@ -123,6 +124,27 @@ inline void train_state_input(const std::filesystem::path& run_dir) {
     FUZZ_CHECK(options.resume && options.out == run_dir);
   } catch (const tasks::Error&) {
   } catch (const std::invalid_argument&) {  // validate: an unknown model kind
+  }
+}
+
+/// The readers of measured-data tables (tasks/data/table.h) on the same bytes as CSV, NumPy .npy
+/// and .npz and the Lipson text: each returns a table whose invariants hold, or refuses with
+/// tasks::Error.
+inline void table_input(const std::string& path) {
+  using Reader = tasks::Table (*)(const std::string&);
+  for (const Reader read : {Reader(tasks::read_csv), Reader(tasks::read_npy),
+                            Reader(tasks::read_npz), Reader(tasks::read_lipson)}) {
+    tasks::Table table;
+    try {
+      table = read(path);
+    } catch (const tasks::Error&) {
+      continue;
+    }
+    FUZZ_CHECK(table.columns() == Eigen::Index(table.names.size()) && table.rows() > 0);
+    FUZZ_CHECK(table.values.allFinite());
+    FUZZ_CHECK(table.lines.empty() || Eigen::Index(table.lines.size()) == table.rows());
+    for (std::size_t c = 0; c < table.names.size(); ++c)
+      FUZZ_CHECK(table.find(table.names[c]) == Eigen::Index(c));  // names are unique
   }
 }
 

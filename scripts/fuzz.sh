@@ -1,19 +1,21 @@
 #!/usr/bin/env bash
 # Fuzzes the readers of untrusted files with libFuzzer (clang, AddressSanitizer + UBSan): the
-# Lipson data loader, the parameter-file reader and the training checkpoint's state.json.
+# Lipson data loader, the parameter-file reader, the training checkpoint's state.json and the
+# measured-data table readers (CSV, .npy, .npz, Lipson text).
 # Each harness runs for FUZZ_SECONDS (default 60) from its corpus, fuzz/corpus/<name>/, plus the
 # inputs earlier runs found (build-fuzz/fuzz-work/<name>/). For the two file formats, inputs that
 # reach new code are merged back into fuzz/corpus/<name>/ (train_state's would be a thousand
 # variations of JSON syntax: they stay in the work folder). A crasher is copied to
 # fuzz/regressions/<name>/ (both are replayed by tests/reliability/fuzz_corpus_test.cpp) and
-# makes the script fail. Usage: scripts/fuzz.sh [name...]   (names: lipson params train_state)
+# makes the script fail. Usage: scripts/fuzz.sh [name...]   (names: lipson params train_state
+# table)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=${FUZZ_SECONDS:-60}
 build_dir=${HNN_FUZZ_BUILD_DIR:-build-fuzz}
 jobs=${HNN_JOBS:-$(nproc)}
 names=("$@")
-[ ${#names[@]} -gt 0 ] || names=(lipson params train_state)
+[ ${#names[@]} -gt 0 ] || names=(lipson params train_state table)
 scripts/setup.sh
 # clang and its libFuzzer runtime, installed only if missing (as setup.sh does for the rest).
 missing=()

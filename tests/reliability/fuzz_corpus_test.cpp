@@ -42,6 +42,15 @@ TEST(FuzzCorpus, ParameterFileInputs) {
   }
 }
 
+TEST(FuzzCorpus, TableInputs) {
+  const std::vector<fs::path> files = inputs("table");
+  EXPECT_GE(files.size(), 10u);
+  for (const fs::path& file : files) {
+    SCOPED_TRACE(file.string());
+    fuzz::table_input(file.string());
+  }
+}
+
 TEST(FuzzCorpus, TrainStateInputs) {
   const TempDir dir;
   const std::vector<fs::path> files = inputs("train_state");
