@@ -3,7 +3,9 @@
 // before xtensor allocates the data, so a corrupt shape cannot ask for terabytes.
 #include <zip.h>
 
+#include <filesystem>
 #include <memory>
+#include <regex>
 #include <sstream>
 #include <xtensor/xnpy.hpp>
 
@@ -43,6 +45,14 @@ std::size_t header_length(const std::string& bytes, int width) {
   return length;
 }
 
+// The header dictionary as NumPy writes it, padded with spaces to a line.
+const std::regex& numpy_header_layout() {
+  static const std::regex layout(
+      R"(\{'descr': *'[<>|=][a-zA-Z][0-9]*', *'fortran_order': *(True|False), *)"
+      R"('shape': *\(( *[0-9]+ *,)* *([0-9]+ *)?\), *\} *\n?)");
+  return layout;
+}
+
 NpyHeader read_npy_header(const std::string& bytes, const std::string& where) {
   HNN_TASKS_CHECK(bytes.size() >= 10 && bytes.compare(0, 6, "\x93NUMPY") == 0,
                   "{}: not a NumPy .npy array (it does not start with \\x93NUMPY)", where);
@@ -53,6 +63,12 @@ NpyHeader read_npy_header(const std::string& bytes, const std::string& where) {
                   length, bytes.size());
   NpyHeader header;
   header.data_offset = 8 + std::size_t(width) + length;
+  // xtensor's parser trusts the header's layout (an empty field is undefined behaviour there,
+  // found by fuzz/table_fuzz.cpp): only NumPy's own layout reaches it.
+  HNN_TASKS_CHECK(std::regex_match(bytes.substr(8 + width, length), numpy_header_layout()),
+                  "{}: not a readable .npy header (not NumPy's {{'descr': ..., 'fortran_order': "
+                  "..., 'shape': (...), }} layout)",
+                  where);
   try {
     xt::detail::parse_header(bytes.substr(8 + width, length), header.descr, &header.fortran_order,
                              header.shape);
@@ -153,11 +169,19 @@ ZipArchive open_zip(const std::string& path) {
 }
 
 std::string read_member(zip_t* archive, zip_uint64_t index, const zip_stat_t& stat,
-                        const std::string& where) {
+                        std::uintmax_t archive_bytes, const std::string& where) {
   std::unique_ptr<zip_file_t, decltype(&zip_fclose)> file(zip_fopen_index(archive, index, 0),
                                                           &zip_fclose);
   HNN_TASKS_CHECK(file != nullptr, "{}: cannot open it in the archive (libzip: {})", where,
                   zip_strerror(archive));
+  // A member's size is the archive's claim: deflate expands at most 1032:1, so a larger claim
+  // (a damaged or hostile archive, found by fuzz/table_fuzz.cpp) is refused before allocating.
+  constexpr zip_uint64_t kMaxRatio = 1032, kSlack = 1024;
+  HNN_TASKS_CHECK((stat.valid & ZIP_STAT_SIZE) && (stat.valid & ZIP_STAT_COMP_SIZE) &&
+                      stat.comp_size <= archive_bytes &&
+                      stat.size <= kMaxRatio * stat.comp_size + kSlack,
+                  "{}: the archive claims {} bytes from {} compressed: not a readable member",
+                  where, stat.size, stat.comp_size);
   std::string bytes;
   try {
     bytes.resize(stat.size);
@@ -202,6 +226,7 @@ Table read_npy(const std::string& path) {
 Table read_npz(const std::string& path) {
   reader::check_readable(path);
   const ZipArchive archive = open_zip(path);
+  const std::uintmax_t archive_bytes = std::filesystem::file_size(path);
   Table table{path, TableFormat::kNpz, {}, {}, {}, {}};
   std::vector<Eigen::MatrixXd> blocks;
   std::string first;
@@ -219,7 +244,8 @@ Table read_npz(const std::string& path) {
     const std::string name = member.substr(0, member.size() - 4);
     const std::string where = fmt::format("{}: array '{}'", path, name);
     add_columns(table, name,
-                parse_npy(read_member(archive.get(), zip_uint64_t(i), stat, where), where, 1),
+                parse_npy(read_member(archive.get(), zip_uint64_t(i), stat, archive_bytes, where),
+                          where, 1),
                 blocks, first);
   }
   HNN_TASKS_CHECK(!blocks.empty(), "{}: the archive holds no arrays", path);
