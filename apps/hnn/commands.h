@@ -14,5 +14,7 @@ void add_reproduce_command(CLI::App& app);
 void add_analysis_commands(CLI::App& app);
 /// simulate: trajectories of a Hamiltonian given as an expression (apps/hnn/simulate_command.cpp).
 void add_simulate_command(CLI::App& app);
+/// export: a trained HNN's H as C source or JSON (apps/hnn/export_command.cpp).
+void add_export_command(CLI::App& app);
 
 }  // namespace hnn::app
