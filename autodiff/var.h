@@ -4,7 +4,6 @@
 // a node on the thread's tape, recycled when the enclosing TapeScope ends.
 
 #include <Eigen/Core>
-
 #include <array>
 #include <cstdint>
 #include <memory>
@@ -42,20 +41,20 @@ struct OpState {
 template <typename T>
 struct Node {
   Matrix<T> value;
-  std::vector<Var<T>> inputs;         // capacity kept across recycling: no allocation per step
-  BackwardFn<T> backward = nullptr;   // null for leaves and for results that need no gradient
-  std::array<double, 3> saved{};      // op constants (exponent, offsets, ...)
-  std::vector<Matrix<T>> buffers;     // fused ops' saved intermediates; kept across recycling
-  std::unique_ptr<OpState> state;     // typed op state (see OpState); kept across recycling
+  std::vector<Var<T>> inputs;        // capacity kept across recycling: no allocation per step
+  BackwardFn<T> backward = nullptr;  // null for leaves and for results that need no gradient
+  std::array<double, 3> saved{};     // op constants (exponent, offsets, ...)
+  std::vector<Matrix<T>> buffers;    // fused ops' saved intermediates; kept across recycling
+  std::unique_ptr<OpState> state;    // typed op state (see OpState); kept across recycling
   const char* op = "leaf";
   bool requires_grad = false;
   bool is_leaf = false;
-  std::uint32_t generation = 0;       // bumped when a tape slot is reused: detects stale handles
-  std::uint64_t seq = 0;              // creation order = a topological order of the graph
+  std::uint32_t generation = 0;  // bumped when a tape slot is reused: detects stale handles
+  std::uint64_t seq = 0;         // creation order = a topological order of the graph
   // Bookkeeping of the gradient sweep that last visited this node.
   std::uint64_t sweep = 0;
   int slot = -1;
-  Matrix<T> grad;                     // accumulated by backward(), leaves only
+  Matrix<T> grad;  // accumulated by backward(), leaves only
   bool has_grad = false;
 
   /// The state of the op recording this node, as S: the recycled object when the slot already

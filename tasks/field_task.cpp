@@ -3,13 +3,12 @@
 
 #include "tasks/field_task.h"
 
-#include <variant>
-
 #include "nn/checkpoint.h"
 #include "nn/hnn.h"
 #include "physics/integrator.h"
 #include "tasks/evaluate/field_evaluation.h"
 #include "tasks/train/field_objective.h"
+#include "tasks/trained_model.h"
 
 namespace hnn::tasks {
 
@@ -34,9 +33,7 @@ class FieldRun : public TaskRun {
     });
   }
 
-  void save(const std::filesystem::path& params) const override {
-    std::visit([&](const auto& model) { nn::save_parameters(params, *checked(model)); }, trained_);
-  }
+  void save(const std::filesystem::path& params) const override { model_.save(params); }
 
   void load(const std::filesystem::path& params) override {
     with_scalar(s_.dtype, [&]<typename T>() {
@@ -62,7 +59,7 @@ class FieldRun : public TaskRun {
                              physics::linspace(0.0, r.t_end.value_or(rollout_span()), r.points));
   }
 
-  const nn::DynamicsModel<double>& dynamics() const override { return *checked(model_); }
+  const nn::DynamicsModel<double>& dynamics() const override { return model_.in_double(); }
 
   // The evaluation's states: a generator independent of the training data's draws.
   physics::Batch rollout_states(int count) const override {
@@ -88,27 +85,16 @@ class FieldRun : public TaskRun {
     return nn::make_model<T>(config, rng);
   }
 
-  // The trained model in its own type (what save writes) and in double (what evaluation uses:
-  // the rollout integrator's tolerance is then not limited by float rounding of the field).
   template <typename T>
   void keep(std::unique_ptr<nn::DynamicsModel<T>> model) {
-    model_ = nn::cast_model<double>(*model);
-    trained_ = std::move(model);
-  }
-
-  template <typename P>
-  static const P& checked(const P& model) {
-    HNN_TASKS_CHECK(model != nullptr, "the run has no model yet: train or load it first");
-    return model;
+    auto in_double = nn::cast_model<double>(*model);
+    model_.keep(std::move(model), std::move(in_double));
   }
 
   const FieldTask& task_;
   RunSettings s_;
   Dataset data_;
-  std::variant<std::unique_ptr<nn::DynamicsModel<float>>,
-               std::unique_ptr<nn::DynamicsModel<double>>>
-      trained_;
-  std::unique_ptr<nn::DynamicsModel<double>> model_;
+  TrainedModel<nn::DynamicsModel> model_;
 };
 
 }  // namespace

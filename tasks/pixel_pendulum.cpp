@@ -6,13 +6,13 @@
 #include <fmt/ranges.h>
 
 #include <algorithm>
-#include <variant>
 
 #include "nn/checkpoint.h"
 #include "tasks/experiments.h"
 #include "tasks/pixel/evaluation.h"
 #include "tasks/pixel/objective.h"
 #include "tasks/run.h"
+#include "tasks/trained_model.h"
 
 namespace hnn::tasks {
 
@@ -73,9 +73,7 @@ class PixelRun : public TaskRun {
     });
   }
 
-  void save(const std::filesystem::path& params) const override {
-    std::visit([&](const auto& model) { nn::save_parameters(params, *checked(model)); }, trained_);
-  }
+  void save(const std::filesystem::path& params) const override { model_.save(params); }
 
   void load(const std::filesystem::path& params) override {
     with_scalar(s_.dtype, [&]<typename T>() {
@@ -127,22 +125,15 @@ class PixelRun : public TaskRun {
 
   template <typename T>
   void keep(std::unique_ptr<PixelModel<T>> model) {
-    model_ = std::make_unique<PixelModel<double>>(model->template cast<double>());
-    trained_ = std::move(model);
+    auto in_double = std::make_unique<PixelModel<double>>(model->template cast<double>());
+    model_.keep(std::move(model), std::move(in_double));
   }
-
-  template <typename P>
-  static const P& checked(const P& model) {
-    HNN_TASKS_CHECK(model != nullptr, "the run has no model yet: train or load it first");
-    return model;
-  }
-  const PixelModel<double>& model() const { return *checked(model_); }
+  const PixelModel<double>& model() const { return model_.in_double(); }
 
   RunSettings s_;
   PixelConfig config_;
   pixel::PixelData data_;
-  std::variant<std::unique_ptr<PixelModel<float>>, std::unique_ptr<PixelModel<double>>> trained_;
-  std::unique_ptr<PixelModel<double>> model_;
+  TrainedModel<PixelModel> model_;
 };
 
 class PixelPendulumTask : public Task {

@@ -279,7 +279,8 @@ def main():
                     help="comma-separated names, 'all' or 'quick': " + ", ".join(CASES))
     ap.add_argument("--impls", default=",".join(IMPLS))
     ap.add_argument("--steps-scale", type=float, default=1.0, help="scales the timing steps")
-    ap.add_argument("--spring-data", default="/work/shared/reference/spring_seed0.f64")
+    ap.add_argument("--spring-data",
+                    default=str(Path(__file__).resolve().parent / "data" / "spring_seed0.f64"))
     ap.add_argument("--coretype", default="Cooperlake", help="OPENBLAS_CORETYPE for the runs")
     ap.add_argument("--python", default="/usr/bin/python3", help="interpreter with torch")
     ap.add_argument("--timeout", type=float, default=900, help="seconds per timing run")

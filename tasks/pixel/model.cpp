@@ -59,28 +59,31 @@ PixelModel<T>::PixelModel(nn::Autoencoder<T> autoencoder,
                           std::unique_ptr<nn::DynamicsModel<T>> dynamics)
     : autoencoder_(std::move(autoencoder)), dynamics_(std::move(dynamics)) {}
 
-template <typename T>
-ad::Matrix<T> PixelModel<T>::encode(const ad::Matrix<T>& x) const {
-  ad::Matrix<T> z(x.rows(), 2);
-  for (Eigen::Index start = 0; start < x.rows(); start += kChunk) {
-    const Eigen::Index n = std::min(kChunk, x.rows() - start);
+namespace {
+
+// `half` (the encoder or the decoder) on plain values, in row chunks, without a graph.
+template <typename T, typename Half>
+ad::Matrix<T> in_chunks(const ad::Matrix<T>& in, Eigen::Index out_cols, Half&& half) {
+  ad::Matrix<T> out(in.rows(), out_cols);
+  for (Eigen::Index start = 0; start < in.rows(); start += kChunk) {
+    const Eigen::Index n = std::min(kChunk, in.rows() - start);
     ad::TapeScope scope;
     ad::NoGradGuard values_only;
-    z.middleRows(start, n) = encode(ad::Var<T>::constant(x.middleRows(start, n))).value();
+    out.middleRows(start, n) = half(ad::Var<T>::constant(in.middleRows(start, n))).value();
   }
-  return z;
+  return out;
+}
+
+}  // namespace
+
+template <typename T>
+ad::Matrix<T> PixelModel<T>::encode(const ad::Matrix<T>& x) const {
+  return in_chunks<T>(x, 2, [this](const ad::Var<T>& v) { return encode(v); });
 }
 
 template <typename T>
 ad::Matrix<T> PixelModel<T>::decode(const ad::Matrix<T>& z) const {
-  ad::Matrix<T> x(z.rows(), kPairPixels);
-  for (Eigen::Index start = 0; start < z.rows(); start += kChunk) {
-    const Eigen::Index n = std::min(kChunk, z.rows() - start);
-    ad::TapeScope scope;
-    ad::NoGradGuard values_only;
-    x.middleRows(start, n) = decode(ad::Var<T>::constant(z.middleRows(start, n))).value();
-  }
-  return x;
+  return in_chunks<T>(z, kPairPixels, [this](const ad::Var<T>& v) { return decode(v); });
 }
 
 template <typename T>

@@ -10,9 +10,8 @@
 #include <random>
 
 #include "autodiff/autodiff.h"
-#include "nn/nn.h"
-
 #include "malloc_counter.h"
+#include "nn/nn.h"
 
 namespace {
 std::atomic<long> g_allocations{0};

@@ -19,12 +19,12 @@ namespace hnn::tasks {
 namespace {
 
 // A model whose field is any function: the exact field (an oracle), zero, or one that blows up.
-// The evaluator only needs field(); the MLP is a placeholder the base class requires.
+// The evaluator only needs field(); the base class also requires an MLP, which goes unused.
 class FunctionModel : public nn::DynamicsModel<double> {
  public:
   using Fn = std::function<Batch(const Batch&)>;
   FunctionModel(Eigen::Index dim, Fn fn)
-      : DynamicsModel(config(dim), placeholder(dim)), fn_(std::move(fn)) {}
+      : DynamicsModel(config(dim), unused_mlp(dim)), fn_(std::move(fn)) {}
   ad::Var<double> time_derivative(const ad::Var<double>&) const override {
     throw std::logic_error("FunctionModel gives values only");
   }
@@ -34,7 +34,7 @@ class FunctionModel : public nn::DynamicsModel<double> {
   static nn::DynamicsConfig config(Eigen::Index dim) {
     return {.model = nn::ModelKind::kBaseline, .dim = dim, .hidden = {2}};
   }
-  static nn::Mlp<double> placeholder(Eigen::Index dim) {
+  static nn::Mlp<double> unused_mlp(Eigen::Index dim) {
     std::mt19937_64 rng(0);
     return nn::Mlp<double>(nn::mlp_config(config(dim)), rng);
   }
