@@ -3,45 +3,19 @@
 
 #include "tasks/field_task.h"
 
-#include "nn/checkpoint.h"
-#include "nn/hnn.h"
 #include "physics/integrator.h"
 #include "tasks/evaluate/field_evaluation.h"
+#include "tasks/field_model_run.h"
 #include "tasks/train/field_objective.h"
-#include "tasks/trained_model.h"
 
 namespace hnn::tasks {
 
 namespace {
 
-class FieldRun : public TaskRun {
+class FieldRun : public FieldModelRun {
  public:
   FieldRun(const FieldTask& task, RunSettings settings)
-      : task_(task), s_(std::move(settings)), data_(task.build_dataset(s_)) {
-    // Checked before a run folder exists: a bad batch size leaves nothing behind.
-    HNN_TASKS_CHECK(s_.train.batch_size <= data_.train_x.rows(),
-                    "--batch {} is larger than the training set ({} rows)", s_.train.batch_size,
-                    data_.train_x.rows());
-  }
-
-  TrainResult train(const LoopOptions& loop) override {
-    return with_scalar(s_.dtype, [&]<typename T>() {
-      std::unique_ptr<nn::DynamicsModel<T>> model = fresh_model<T>();
-      const TrainResult result = train_model(*model, data_, s_.train, s_.seed, loop);
-      keep(std::move(model));
-      return result;
-    });
-  }
-
-  void save(const std::filesystem::path& params) const override { model_.save(params); }
-
-  void load(const std::filesystem::path& params) override {
-    with_scalar(s_.dtype, [&]<typename T>() {
-      std::unique_ptr<nn::DynamicsModel<T>> model = fresh_model<T>();
-      nn::load_parameters(params, *model);
-      keep(std::move(model));
-    });
-  }
+      : FieldModelRun(settings, task.build_dataset(settings)), task_(task) {}
 
   nlohmann::json evaluate(const RunFolder* folder) const override {
     const RolloutConfig config = task_.rollout_config();
@@ -59,8 +33,6 @@ class FieldRun : public TaskRun {
                              physics::linspace(0.0, r.t_end.value_or(rollout_span()), r.points));
   }
 
-  const nn::DynamicsModel<double>& dynamics() const override { return model_.in_double(); }
-
   // The evaluation's states: a generator independent of the training data's draws.
   physics::Batch rollout_states(int count) const override {
     std::mt19937_64 rng(s_.seed + 1);
@@ -72,29 +44,7 @@ class FieldRun : public TaskRun {
   double rollout_span() const override { return task_.rollout_config().t_end; }
 
  private:
-  template <typename T>
-  std::unique_ptr<nn::DynamicsModel<T>> fresh_model() const {
-    nn::DynamicsConfig config{.model = s_.model, .dim = data_.train_x.cols()};
-    config.hidden.assign(s_.train.hidden.begin(), s_.train.hidden.end());
-    try {
-      nn::validate(config);
-    } catch (const std::invalid_argument& e) {
-      throw Error(fmt::format("task '{}': {}", s_.task, e.what()));
-    }
-    std::mt19937_64 rng(s_.seed);
-    return nn::make_model<T>(config, rng);
-  }
-
-  template <typename T>
-  void keep(std::unique_ptr<nn::DynamicsModel<T>> model) {
-    auto in_double = nn::cast_model<double>(*model);
-    model_.keep(std::move(model), std::move(in_double));
-  }
-
   const FieldTask& task_;
-  RunSettings s_;
-  Dataset data_;
-  TrainedModel<nn::DynamicsModel> model_;
 };
 
 }  // namespace

@@ -143,7 +143,7 @@ json table_of(const std::vector<RunOptions>& runs, const std::vector<json>& resu
 json reproduce(const ReproduceOptions& o) {
   HNN_TASKS_CHECK(o.seeds >= 1, "--seeds must be at least 1, got {}", o.seeds);
   HNN_TASKS_CHECK(o.jobs >= 1, "--jobs must be at least 1, got {}", o.jobs);
-  const std::vector<std::string> tasks = o.tasks.empty() ? task_names() : o.tasks;
+  const std::vector<std::string> tasks = o.tasks.empty() ? paper_task_names() : o.tasks;
   const std::vector<RunOptions> runs = plan_runs(o, tasks);
   fs::create_directories(o.out);
   fmt::print(stderr, "reproduce: {} runs on {} thread(s) into {}\n", runs.size(), o.jobs,
@@ -166,7 +166,7 @@ json reproduce(const ReproduceOptions& o) {
 
 json reversibility_report(const fs::path& results, const ReversibilityOptions& options) {
   json rows = json::array();
-  for (const std::string& task : task_names()) {
+  for (const std::string& task : paper_task_names()) {
     for (const nn::ModelKind model : kModels) {
       fs::path dir = results / task / std::string(nn::to_string(model));
       if (!fs::exists(dir / "metrics.json")) dir /= "seed-0";

@@ -1,5 +1,6 @@
 #include "tasks/task.h"
 
+#include <algorithm>
 #include <functional>
 #include <utility>
 
@@ -18,7 +19,8 @@ const std::vector<std::pair<std::string, Factory>>& registry() {
       {"real-pendulum", make_real_pendulum_task},
       {"two-body", make_two_body_task},
       {"three-body", make_three_body_task},
-      {"pixel-pendulum", make_pixel_pendulum_task}};
+      {"pixel-pendulum", make_pixel_pendulum_task},
+      {"data", make_data_task}};
   return tasks;
 }
 
@@ -35,6 +37,12 @@ void Task::write_comparison(const std::filesystem::path&, const std::filesystem:
 std::vector<std::string> task_names() {
   std::vector<std::string> names;
   for (const auto& [name, factory] : registry()) names.push_back(name);
+  return names;
+}
+
+std::vector<std::string> paper_task_names() {
+  std::vector<std::string> names = task_names();
+  names.erase(std::remove(names.begin(), names.end(), "data"), names.end());
   return names;
 }
 

@@ -89,9 +89,11 @@ class Task {
   virtual std::unique_ptr<TaskRun> open(const RunSettings& settings) const = 0;
 };
 
-/// The tasks by name: spring, pendulum, real-pendulum, two-body, three-body, pixel-pendulum.
-/// Throws Error naming the known tasks for any other name.
+/// The tasks by name: spring, pendulum, real-pendulum, two-body, three-body, pixel-pendulum (the
+/// paper's) and data (a user's own file). Throws Error naming the known tasks for any other name.
 std::unique_ptr<Task> make_task(const std::string& name);
 std::vector<std::string> task_names();
+/// The paper's six: what `hnn reproduce` runs by default.
+std::vector<std::string> paper_task_names();
 
 }  // namespace hnn::tasks

@@ -67,7 +67,9 @@ void train_until_done_or_stopped(tasks::RunOptions o) {
 // the result may be given again.
 tasks::RunOptions resumed_options(const CLI::App& cmd, const std::string& dir, bool quiet) {
   for (const char* name : {"task", "--model", "--steps", "--seed", "--dtype", "--preset", "--batch",
-                           "--hidden", "--lr", "--data", "--settings", "--out"}) {
+                           "--hidden", "--lr", "--data", "--settings", "--out", "--coords", "--momenta",
+                           "--velocities", "--derivatives", "--time", "--trajectory", "--split",
+                           "--test-fraction", "--hamiltonian"}) {
     if (cmd.get_option(name)->count() > 0) {
       throw std::invalid_argument(fmt::format(
           "{} cannot be combined with --resume: a resumed run keeps its own settings", name));
@@ -131,7 +133,7 @@ void add_train_command(CLI::App& app) {
       ->check(integer_in(1, tasks::kMaxWidth));
   cmd->add_option("--lr", *lr, "Adam learning rate (default 1e-3)")->check(positive_real());
   cmd->add_option("--data", options->data_file,
-                  "A measured-data file of the same format (real-pendulum)");
+                  "The data task's file, or real-pendulum's measured data in its format");
   cmd->add_option("--out", options->out, "Run folder (default runs/TASK/MODEL)");
   cmd->add_flag("--quiet", options->quiet, "No progress output");
   auto settings = std::make_shared<std::string>();
@@ -144,6 +146,7 @@ void add_train_command(CLI::App& app) {
   cmd->add_option("--resume", *resume,
                   "Continue the interrupted run in this folder from its last checkpoint")
       ->check(CLI::ExistingDirectory);
+  const auto data_options = add_data_options(*cmd);
   cmd->callback([=] {
     if (!resume->empty())
       return train_until_done_or_stopped(resumed_options(*cmd, *resume, options->quiet));
@@ -153,6 +156,7 @@ void add_train_command(CLI::App& app) {
     o.dtype = tasks::parse_dtype(*dtype);
     o.preset = tasks::parse_preset(*preset);
     if (!settings->empty()) o.task_settings = task_settings(*settings);
+    data_options(o.task_settings, o.task);
     if (*steps > 0) o.steps = *steps;
     if (*batch >= 0) o.batch_size = *batch;
     if (*lr > 0) o.learning_rate = *lr;

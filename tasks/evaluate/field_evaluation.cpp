@@ -12,18 +12,12 @@ namespace hnn::tasks {
 
 using nlohmann::json;
 
-namespace {
-
-// 1 - MSE / variance of the targets (over all components): the share of the targets' spread
-// the model explains, whatever the data's units.
 double r_squared(double mse, const Batch& dxdt) {
   if (dxdt.rows() == 0) return NAN;
   const Eigen::RowVectorXd mean = dxdt.colwise().mean();
   const double variance = (dxdt.rowwise() - mean).squaredNorm() / double(dxdt.size());
   return variance > 0 ? 1 - mse / variance : NAN;
 }
-
-}  // namespace
 
 FieldEvaluation evaluate_field_model(const physics::System& truth,
                                      const nn::DynamicsModel<double>& model, const Dataset& data,

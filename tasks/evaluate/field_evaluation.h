@@ -19,6 +19,10 @@ struct FieldEvaluation {
   Rollouts rollouts{};
 };
 
+/// 1 - MSE / variance of the targets (over all components): the share of the targets' spread a
+/// model explains, whatever the data's units. NaN for no targets or constant ones.
+double r_squared(double mse, const Batch& dxdt);
+
 /// Evaluates `model` on `data` and on rollouts from `x0` against `truth`.
 FieldEvaluation evaluate_field_model(const physics::System& truth,
                                      const nn::DynamicsModel<double>& model, const Dataset& data,

@@ -34,11 +34,16 @@ Eigen::MatrixXd integrate_one(const physics::VectorField& field, const Eigen::Ro
 
 nn::MeanStderr loss_stats(const nn::DynamicsModel<double>& model, const Batch& x,
                           const Batch& dxdt) {
+  return loss_stats(learned_field(model).field, x, dxdt);
+}
+
+nn::MeanStderr loss_stats(const physics::VectorField& field, const Batch& x, const Batch& dxdt) {
   if (x.rows() == 0) throw std::invalid_argument("loss_stats: no points");
   Batch errors(x.rows(), x.cols());  // squared error of every component of every point
+  Batch pred;
   for (Eigen::Index start = 0; start < x.rows(); start += kChunk) {
     const Eigen::Index n = std::min(kChunk, x.rows() - start);
-    const Batch pred = model.field(x.middleRows(start, n));
+    field(0.0, x.middleRows(start, n), pred);
     errors.middleRows(start, n) = (pred - dxdt.middleRows(start, n)).array().square().matrix();
   }
   // The reference's error bar: torch's std (n - 1) over all N x D squared errors, / sqrt(N).
@@ -47,28 +52,40 @@ nn::MeanStderr loss_stats(const nn::DynamicsModel<double>& model, const Batch& x
   return {mean, std::sqrt(variance / double(x.rows())), std::size_t(x.rows())};
 }
 
+LearnedField learned_field(const nn::DynamicsModel<double>& model) {
+  LearnedField learned{.field = [&model](double, const Batch& x, Batch& dxdt) {
+    dxdt = model.field(x);
+  }};
+  const auto* hnn = dynamic_cast<const nn::Hnn<double>*>(&model);
+  if (hnn != nullptr && model.config().field != nn::FieldType::kConservative)
+    learned.hamiltonian = [hnn](const Batch& x) -> Eigen::VectorXd { return hnn->energy(x).col(0); };
+  return learned;
+}
+
 Rollouts make_rollouts(const physics::System& truth, const nn::DynamicsModel<double>& model,
                        const Batch& x0, const RolloutConfig& config) {
-  const auto* hnn = dynamic_cast<const nn::Hnn<double>*>(&model);
-  const bool has_h = hnn != nullptr && model.config().field != nn::FieldType::kConservative;
-  const physics::VectorField learned = [&model](double, const Batch& x, Batch& dxdt) {
-    dxdt = model.field(x);
-  };
+  return make_rollouts(truth, learned_field(model), x0, config);
+}
+
+Rollouts make_rollouts(const physics::System& truth, const LearnedField& learned, const Batch& x0,
+                       const RolloutConfig& config) {
   Rollouts r;
   r.t = physics::linspace(0.0, config.t_end, config.points);
   const Eigen::Index n = x0.rows(), m = Eigen::Index(r.t.size());
   r.true_energy.setConstant(n, m, NAN);
   r.pred_energy.setConstant(n, m, NAN);
-  if (has_h) r.learned_h.setConstant(n, m, NAN);
+  if (learned.hamiltonian) r.learned_h.setConstant(n, m, NAN);
   for (Eigen::Index i = 0; i < n; ++i) {
     const Eigen::MatrixXd path = integrate_one(truth.field(), x0.row(i), r.t, config, nullptr);
     r.truth.push_back(path);
     r.true_energy.row(i) = truth.energy_batch(Batch(path)).transpose();
     try {
-      r.pred.push_back(integrate_one(learned, x0.row(i), r.t, config, &r.nfev, kMaxLearnedSteps));
+      r.pred.push_back(
+          integrate_one(learned.field, x0.row(i), r.t, config, &r.nfev, kMaxLearnedSteps));
       r.failed.push_back(false);
       r.pred_energy.row(i) = truth.energy_batch(Batch(r.pred.back())).transpose();
-      if (has_h) r.learned_h.row(i) = hnn->energy(Batch(r.pred.back())).col(0).transpose();
+      if (learned.hamiltonian)
+        r.learned_h.row(i) = learned.hamiltonian(Batch(r.pred.back())).transpose();
     } catch (const physics::IntegrationError& e) {
       r.pred.push_back(Eigen::MatrixXd::Constant(m, x0.cols(), NAN));
       r.failed.push_back(true);

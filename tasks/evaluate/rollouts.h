@@ -2,6 +2,7 @@
 // The shared evaluator: final losses with standard errors, and rollouts of the true and learned
 // fields from the same initial states for the energy metric and the charts.
 
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -28,6 +29,8 @@ struct RolloutConfig {
 /// normalised) / sqrt(N), the convention of the paper's Table 1. Throws on an empty split.
 nn::MeanStderr loss_stats(const nn::DynamicsModel<double>& model, const Batch& x,
                           const Batch& dxdt);
+/// The same for any field (a model in other units, say).
+nn::MeanStderr loss_stats(const physics::VectorField& field, const Batch& x, const Batch& dxdt);
 
 /// Rollouts from n initial states at the same times. Row i of each matrix is trajectory i.
 struct Rollouts {
@@ -40,11 +43,23 @@ struct Rollouts {
   long nfev = 0;                             // learned-field evaluations, all trajectories
 };
 
+/// A learned field as rollouts use it: f(x), and H(x) for a model that learns one.
+struct LearnedField {
+  physics::VectorField field;
+  std::function<Eigen::VectorXd(const Batch&)> hamiltonian{};  ///< empty: the model has none
+};
+
+/// The model's field and, for an HNN with a solenoidal part, its learned H. Refers to model.
+LearnedField learned_field(const nn::DynamicsModel<double>& model);
+
 /// Integrates the true field and the model's field from each row of x0 with the adaptive
 /// Dormand-Prince 5(4) method at config.rtol. A learned rollout that blows up is recorded as
 /// failed (with the time reached), never padded or silently dropped.
 Rollouts make_rollouts(const physics::System& truth, const nn::DynamicsModel<double>& model,
                        const Batch& x0, const RolloutConfig& config);
+/// The same for any learned field (a model in other units, say).
+Rollouts make_rollouts(const physics::System& truth, const LearnedField& learned, const Batch& x0,
+                       const RolloutConfig& config);
 
 /// Energy MSE: mean over trajectories and times of (E(true) - E(model))^2, with a standard error
 /// from 5 interleaved splits of the trajectories (the reference's "bootstrap" of 5 splits).

@@ -36,7 +36,7 @@ TEST(Presets, AreNamedPaperAndLean) {
 }
 
 TEST(Presets, PaperIsTheTasksOwnConfiguration) {
-  for (const std::string& name : task_names()) {
+  for (const std::string& name : paper_task_names()) {
     const auto task = make_task(name);
     const TrainConfig own = task->train_config(), paper = train_config(*task, Preset::kPaper);
     EXPECT_EQ(paper.hidden, own.hidden) << name;

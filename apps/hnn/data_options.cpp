@@ -1,0 +1,64 @@
+// The data task's options of `hnn train`: each one a key of the task's settings (metrics.json's
+// "task_settings"), so a resumed or reloaded run reads its file the same way.
+
+#include <fmt/format.h>
+
+#include "apps/hnn/commands.h"
+#include "apps/hnn/validators.h"
+
+namespace hnn::app {
+
+std::function<void(nlohmann::json&, const std::string&)> add_data_options(CLI::App& cmd) {
+  struct Values {
+    std::vector<std::string> coords, momenta, velocities, derivatives;
+    std::string time, trajectory, split, hamiltonian;
+    double test_fraction = 0;
+  };
+  auto v = std::make_shared<Values>();
+  const char* group = "The data task (hnn train data --data FILE)";
+  const auto list = [&](const char* name, std::vector<std::string>& into, const char* help) {
+    cmd.add_option(name, into, help)->delimiter(',')->group(group);
+  };
+  list("--coords", v->coords, "Coordinate columns q (names or 0-based indices, comma-separated)");
+  list("--momenta", v->momenta, "Momentum columns p, one per coordinate");
+  list("--velocities", v->velocities,
+       "Velocity columns dq/dt instead of momenta (unit masses assumed)");
+  list("--derivatives", v->derivatives,
+       "Columns of dx/dt, one per state column (default: finite differences)");
+  cmd.add_option("--time", v->time, "Time column (default: t, else time)")->group(group);
+  cmd.add_option("--trajectory", v->trajectory,
+                 "Trajectory id column (default: trajectory, else trial; none: one trajectory)")
+      ->group(group);
+  cmd.add_option("--split", v->split, "Test split: auto, trajectories or time")
+      ->check(CLI::IsMember({"auto", "trajectories", "time"}))
+      ->group(group);
+  cmd.add_option("--test-fraction", v->test_fraction,
+                 "Share of the trajectories (or of each one's rows) held out (default 0.2)")
+      ->check(CLI::Range(0.0, 1.0).description("in (0, 1)"))
+      ->group(group);
+  cmd.add_option("--hamiltonian", v->hamiltonian,
+                 "A known H over the state's column names, for the energy metric")
+      ->group(group);
+  // Writes the options given into the task's settings; refuses them for another task.
+  return [v, &cmd](nlohmann::json& settings, const std::string& task) {
+    const auto put = [&](const char* option, const char* key, const nlohmann::json& value) {
+      if (cmd.get_option(option)->count() == 0) return;
+      if (task != "data") {
+        throw std::invalid_argument(
+            fmt::format("{} applies to the data task only, not to '{}'", option, task));
+      }
+      settings[key] = value;
+    };
+    put("--coords", "coords", v->coords);
+    put("--momenta", "momenta", v->momenta);
+    put("--velocities", "velocities", v->velocities);
+    put("--derivatives", "derivatives", v->derivatives);
+    put("--time", "time", v->time);
+    put("--trajectory", "trajectory", v->trajectory);
+    put("--split", "split", v->split);
+    put("--test-fraction", "test_fraction", v->test_fraction);
+    put("--hamiltonian", "hamiltonian", v->hamiltonian);
+  };
+}
+
+}  // namespace hnn::app

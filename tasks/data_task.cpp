@@ -1,0 +1,295 @@
+// The `data` task: a user's own trajectories, measured or simulated (CSV, .npy, .npz or the
+// Schmidt & Lipson text format), learned in standardised units and reported in the file's.
+// Without a known H it is judged by rolling out from each held-out stretch's first state; with
+// one (--hamiltonian) also by the energy MSE of the other tasks.
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+
+#include "physics/expression_system.h"
+#include "physics/integrator.h"
+#include "tasks/data/units.h"
+#include "tasks/evaluate/field_evaluation.h"
+#include "tasks/evaluate/held_out.h"
+#include "tasks/experiments.h"
+#include "tasks/field_model_run.h"
+#include "tasks/report/json_values.h"
+
+namespace hnn::tasks {
+
+namespace {
+
+using nlohmann::json;
+
+// The data task's own settings (`hnn train data`'s options write them).
+struct DataConfig {
+  MeasuredDataOptions measured;
+  std::string hamiltonian;  ///< empty: no known H
+  bool standardize = true;
+  double threshold = 0.1;
+  int energy_rollouts = 15;
+  double energy_t_end = 0;  ///< 0: the held-out stretches' median duration
+};
+
+const std::vector<std::string>& setting_names() {
+  static const std::vector<std::string> names = {
+      "coords",         "momenta",   "velocities",      "derivatives",    "time",
+      "trajectory",     "split",     "test_fraction",   "gap_factor",     "hamiltonian",
+      "standardize",    "threshold", "energy_rollouts", "energy_t_end"};
+  return names;
+}
+
+// A column list: an array of names or indices, or one name.
+std::vector<std::string> columns(const json& j) {
+  const json list = j.is_array() ? j : json::array({j});
+  std::vector<std::string> out;
+  for (const json& c : list) out.push_back(c.is_string() ? c.get<std::string>() : c.dump());
+  return out;
+}
+
+SplitBy parse_split(const std::string& name) {
+  if (name == "auto") return SplitBy::kAuto;
+  if (name == "trajectories") return SplitBy::kTrajectories;
+  if (name == "time") return SplitBy::kTime;
+  throw Error(fmt::format("data: split '{}' is not one of auto, trajectories, time", name));
+}
+
+DataConfig data_config(const json& s) {
+  DataConfig c;
+  ColumnChoice& col = c.measured.columns;
+  try {
+    if (s.contains("coords")) col.coords = columns(s["coords"]);
+    if (s.contains("momenta")) col.momenta = columns(s["momenta"]);
+    if (s.contains("velocities")) col.velocities = columns(s["velocities"]);
+    if (s.contains("derivatives")) col.derivatives = columns(s["derivatives"]);
+    if (s.contains("time")) col.time = columns(s["time"]).at(0);
+    if (s.contains("trajectory")) col.trajectory = columns(s["trajectory"]).at(0);
+    col.gap_factor = s.value("gap_factor", col.gap_factor);
+    c.measured.split.by = parse_split(s.value("split", std::string("auto")));
+    c.measured.split.test_fraction = s.value("test_fraction", c.measured.split.test_fraction);
+    c.hamiltonian = s.value("hamiltonian", std::string());
+    c.standardize = s.value("standardize", true);
+    c.threshold = s.value("threshold", c.threshold);
+    c.energy_rollouts = json_integer<int>(s.value("energy_rollouts", json(15)), "energy_rollouts");
+    c.energy_t_end = s.value("energy_t_end", 0.0);
+  } catch (const json::exception& e) {
+    throw Error(fmt::format("data: bad task settings {}: {}", s.dump(), e.what()));
+  }
+  HNN_TASKS_CHECK(c.threshold > 0 && c.threshold < 1,
+                  "data: threshold {} is not between 0 and 1 (a relative state error)",
+                  c.threshold);
+  HNN_TASKS_CHECK(c.energy_rollouts >= 1, "data: energy_rollouts must be at least 1, got {}",
+                  c.energy_rollouts);
+  HNN_TASKS_CHECK(c.energy_t_end >= 0 && std::isfinite(c.energy_t_end),
+                  "data: energy_t_end must be positive (or 0: the held-out duration), got {}",
+                  c.energy_t_end);
+  return c;
+}
+
+// The H of --hamiltonian over the state's column names.
+std::unique_ptr<physics::ExpressionSystem> make_truth(const std::string& expression,
+                                                      const MeasuredData& m) {
+  if (expression.empty()) return nullptr;
+  const auto n = std::ptrdiff_t(m.coordinates);
+  std::vector<std::string> q(m.state_names.begin(), m.state_names.begin() + n),
+      p(m.state_names.begin() + n, m.state_names.end());
+  try {
+    return std::make_unique<physics::ExpressionSystem>(expression, q, p);
+  } catch (const std::invalid_argument& e) {
+    throw Error(fmt::format("--hamiltonian: {} (the state's names: {})", e.what(),
+                            fmt::join(m.state_names, ", ")));
+  }
+}
+
+// A model's field and H in the model's units, seen in the file's.
+LearnedField in_file_units(const LearnedField& model, const Units& u) {
+  LearnedField file{.field = [model, u](double t, const Batch& x, Batch& dxdt) {
+    Batch dzdt;
+    model.field(t / u.time, u.to_model(x), dzdt);
+    dxdt = u.rate_to_file(dzdt);
+  }};
+  if (model.hamiltonian) {
+    file.hamiltonian = [model, u](const Batch& x) -> Eigen::VectorXd {
+      return model.hamiltonian(u.to_model(x)) * u.energy_to_file();
+    };
+  }
+  return file;
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return NAN;
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
+// n rows evenly spread over x.
+Batch spread_rows(const Batch& x, int n) {
+  n = int(std::min<Eigen::Index>(n, x.rows()));
+  Batch out(n, x.cols());
+  for (int i = 0; i < n; ++i) out.row(i) = x.row(Eigen::Index(i) * x.rows() / n);
+  return out;
+}
+
+// What a data run is built from, before the model: the file's trajectories, the units.
+struct Prepared {
+  DataConfig config{};
+  MeasuredData measured{};
+  Units units{};
+  std::unique_ptr<physics::ExpressionSystem> truth{};
+};
+
+Prepared prepare(const RunSettings& s) {
+  HNN_TASKS_CHECK(!s.data_file.empty(),
+                  "the data task needs a file: hnn train data --data FILE (CSV, .npy, .npz or "
+                  "Schmidt & Lipson text)");
+  Prepared p{.config = data_config(s.task_settings)};
+  p.measured = load_measured_data(s.data_file, p.config.measured);
+  HNN_TASKS_CHECK(p.measured.data.train_x.rows() >= 2 && p.measured.data.test_x.rows() >= 1,
+                  "{}: {} training and {} test rows: too few to train and test",
+                  p.measured.source, p.measured.data.train_x.rows(), p.measured.data.test_x.rows());
+  p.units = p.config.standardize
+                ? fit_units(p.measured.data, p.measured.coordinates, p.measured.state_names)
+                : identity_units(p.measured.data.train_x.cols());
+  p.truth = make_truth(p.config.hamiltonian, p.measured);
+  return p;
+}
+
+class DataRun : public FieldModelRun {
+ public:
+  DataRun(RunSettings settings, Prepared p)
+      : FieldModelRun(std::move(settings), p.units.to_model(p.measured.data)), p_(std::move(p)) {}
+
+  json evaluate(const RunFolder* folder) const override {
+    const LearnedField model = learned_field(dynamics());
+    const LearnedField file = in_file_units(model, p_.units);
+    const Dataset& d = p_.measured.data;
+    const nn::MeanStderr train = loss_stats(file.field, d.train_x, d.train_dxdt);
+    const nn::MeanStderr test = loss_stats(file.field, d.test_x, d.test_dxdt);
+    json m = {{"train_loss", number(train.mean)}, {"train_loss_se", number(train.std_error)},
+              {"test_loss", number(test.mean)},   {"test_loss_se", number(test.std_error)},
+              {"train_r2", number(r_squared(train.mean, d.train_dxdt))},
+              {"test_r2", number(r_squared(test.mean, d.test_dxdt))},
+              {"n_train", d.train_x.rows()},      {"n_test", d.test_x.rows()}};
+    const HeldOutEvaluation held = evaluate_held_out(
+        model, p_.units, p_.measured.held_out, p_.measured.coordinates, data_.train_x,
+        {.threshold = p_.config.threshold, .truth = p_.truth.get()});
+    m.update(held.metrics);
+    m.update(energy_metrics(file));
+    m["units"] = p_.units.to_json();
+    m["state_names"] = p_.measured.state_names;
+    m["data"] = describe(p_.measured);
+    if (folder) folder->write_text("rollout.csv", held_out_csv(held));
+    return m;
+  }
+
+  // `hnn rollout`: the measured held-out stretches ("data") and the model's paths from their
+  // first states with the requested integrator, in the file's units.
+  std::string rollout_csv(const RolloutRequest& r) const override {
+    const Units& u = p_.units;
+    const auto integrator = physics::make_integrator(
+        r.integrator, {.dt = r.dt / u.time, .rtol = r.rtol, .atol = r.rtol * 1e-3});
+    const LearnedField model = learned_field(dynamics());
+    const std::vector<double> t =
+        physics::linspace(0.0, r.t_end.value_or(rollout_span() * u.time), r.points);
+    std::vector<double> t_model(t.size());
+    std::transform(t.begin(), t.end(), t_model.begin(), [&](double v) { return v / u.time; });
+    std::string csv = "source,traj,t";
+    for (const std::string& name : p_.measured.state_names) csv += "," + name;
+    csv += ",energy,learned_h\n";
+    const auto& held = p_.measured.held_out;
+    for (std::size_t i = 0; i < held.size() && int(i) < r.trajectories; ++i) {
+      append_rows(csv, "data", i, (held[i].t.array() - held[i].t(0)).matrix(), held[i].x,
+                  std::nullopt);
+      const Batch z = integrator->integrate(model.field, u.to_model(Batch(held[i].x.topRows(1))),
+                                            t_model).path(0);
+      std::optional<Eigen::VectorXd> h;
+      if (model.hamiltonian) h = model.hamiltonian(z) * u.energy_to_file();
+      append_rows(csv, nn::to_string(s_.model), i,
+                  Eigen::Map<const Eigen::VectorXd>(t.data(), Eigen::Index(t.size())),
+                  u.to_file(z), h);
+    }
+    return csv;
+  }
+
+  // Test states spread over the held-out rows, in the model's units.
+  Batch rollout_states(int count) const override { return spread_rows(data_.test_x, count); }
+
+  // The held-out stretches' median duration, in the model's time unit.
+  double rollout_span() const override { return held_out_duration() / p_.units.time; }
+
+ private:
+  double held_out_duration() const {
+    std::vector<double> spans;
+    for (const HeldOut& h : p_.measured.held_out) spans.push_back(h.t(h.t.size() - 1) - h.t(0));
+    return median(spans);
+  }
+
+  // With a known H, the energy MSE of the other tasks: the true and the learned field from test
+  // states over the held-out duration (or energy_t_end).
+  json energy_metrics(const LearnedField& file) const {
+    if (!p_.truth) {
+      return {{"energy_mse", nullptr},
+              {"energy_mse_se", nullptr},
+              {"energy_note", "no known Hamiltonian: give one with --hamiltonian EXPR"}};
+    }
+    const double t_end = p_.config.energy_t_end > 0 ? p_.config.energy_t_end : held_out_duration();
+    const RolloutConfig config{.trajectories = p_.config.energy_rollouts, .t_end = t_end};
+    const Rollouts r = make_rollouts(*p_.truth, file,
+                                     spread_rows(p_.measured.data.test_x, config.trajectories),
+                                     config);
+    const nn::MeanStderr e = energy_mse(r);
+    return {{"energy_mse", number(e.mean)},
+            {"energy_mse_se", number(e.std_error)},
+            {"n_rollouts", e.count},
+            {"rollout_failures", r.failures},
+            {"energy_t_end", t_end},
+            {"hamiltonian", p_.config.hamiltonian}};
+  }
+
+  // Rows source,traj,t,x..,energy (with a known H),learned_h (with h).
+  void append_rows(std::string& csv, std::string_view source, std::size_t traj,
+                   const Eigen::VectorXd& t, const Batch& x,
+                   const std::optional<Eigen::VectorXd>& h) const {
+    const Eigen::VectorXd energy =
+        p_.truth ? p_.truth->energy_batch(x) : Eigen::VectorXd::Constant(x.rows(), NAN);
+    for (Eigen::Index k = 0; k < x.rows(); ++k) {
+      csv += fmt::format("{},{},{:.12g}", source, traj, t(k));
+      for (Eigen::Index c = 0; c < x.cols(); ++c) csv += fmt::format(",{:.12g}", x(k, c));
+      csv += std::isfinite(energy(k)) ? fmt::format(",{:.12g},", energy(k)) : std::string(",,");
+      csv += h ? fmt::format("{:.12g}\n", (*h)(k)) : std::string("\n");
+    }
+  }
+
+  Prepared p_;
+};
+
+class DataTask : public Task {
+ public:
+  std::string name() const override { return "data"; }
+  std::string summary() const override {
+    return "your own trajectories: --data FILE (CSV, .npy, .npz, Schmidt & Lipson text)";
+  }
+  TrainConfig train_config() const override { return {}; }
+  PaperRow paper(nn::ModelKind) const override {
+    return {{NAN, NAN}, {NAN, NAN}, {NAN, NAN}};  // not one of the paper's tasks
+  }
+  bool reads_data_file() const override { return true; }
+  void check_task_settings(const json& settings) const override {
+    for (const auto& [key, value] : settings.items()) {
+      HNN_TASKS_CHECK(
+          std::find(setting_names().begin(), setting_names().end(), key) != setting_names().end(),
+          "the data task has no setting '{}' (known: {})", key, fmt::join(setting_names(), ", "));
+    }
+    data_config(settings);
+  }
+  std::unique_ptr<TaskRun> open(const RunSettings& settings) const override {
+    return std::make_unique<DataRun>(settings, prepare(settings));
+  }
+};
+
+}  // namespace
+
+std::unique_ptr<Task> make_data_task() { return std::make_unique<DataTask>(); }
+
+}  // namespace hnn::tasks
