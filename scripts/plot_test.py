@@ -19,6 +19,7 @@ import numpy as np
 PLOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "plot.py")
 PYTHON = "/usr/bin/python3"
 KEYS = ["train_loss", "test_loss", "energy_mse"]
+MODELS = ["baseline", "hnn"]
 
 
 # ---------------------------------------------------------------------------------------------
@@ -26,17 +27,18 @@ KEYS = ["train_loss", "test_loss", "energy_mse"]
 
 
 def write_rollout(path, t, trajs):
-    """trajs: list of (true states T x d, pred states T x d, true E, pred E, learned H or None)."""
+    """trajs: list of (true states T x d, pred states T x d, true E, pred E, learned H), any of
+    the last three None for empty cells; t: the times, shared or a list with one per trajectory."""
     d = trajs[0][0].shape[1]
     header = (["traj", "t"] + [f"true_{i}" for i in range(d)] + [f"pred_{i}" for i in range(d)]
               + ["true_energy", "pred_energy", "learned_h"])
     with open(path, "w") as f:
         f.write(",".join(header) + "\n")
         for k, (true, pred, e_true, e_pred, h) in enumerate(trajs):
-            for i, ti in enumerate(t):
+            for i, ti in enumerate(t[k] if isinstance(t, list) else t):
                 cells = [str(k), f"{ti:.6g}"] + [f"{v:.9g}" for v in true[i]]
-                cells += [f"{v:.9g}" for v in pred[i]] + [f"{e_true[i]:.9g}", f"{e_pred[i]:.9g}"]
-                cells.append("" if h is None else f"{h[i]:.9g}")
+                cells += [f"{v:.9g}" for v in pred[i]]
+                cells += ["" if e is None else f"{e[i]:.9g}" for e in (e_true, e_pred, h)]
                 f.write(",".join(cells) + "\n")
 
 
@@ -138,6 +140,49 @@ def three_body_rollouts(model):
     return t, trajs
 
 
+def data_rollouts(model, steps=(0.05, 0.05, 0.05)):
+    """Two uncoupled oscillators, x = (x, y, p_x, p_y), measured in three held-out stretches of
+    different lengths that start at different times, each sampled every steps[k]; no known H
+    (empty energy cells). The baseline's amplitude decays, the HNN has a small phase error."""
+    omega, amp = np.array([1.0, 1.7]), np.array([1.0, 0.6])
+    times, trajs = [], []
+    for k, (start, count) in enumerate(((3.0, 80), (12.5, 50), (30.0, 120))):
+        t = start + steps[k] * np.arange(count)
+        tau = t - t[0]
+
+        def state(a, w, phase):
+            return np.concatenate([a * np.cos(phase), -a * w * np.sin(phase)], axis=1)
+
+        phase = omega * t[:, None] + 0.4 * k
+        true = state(amp, omega, phase)
+        if model == "baseline":
+            pred = state(amp * np.exp(-0.05 * tau)[:, None], omega, phase + 0.02 * tau[:, None])
+            h = None
+        else:
+            pred = state(amp, omega, phase + 0.004 * tau[:, None])
+            h = 0.5 * np.sum(pred[:, 2:] ** 2 + (omega * pred[:, :2]) ** 2, axis=1) - 3.0
+            h = h * (1 + 1e-3 * np.sin(tau))
+        times.append(t)
+        trajs.append((true, pred, None, None, h))
+    return times, trajs
+
+
+def write_data_run(folder, model, **rollout_options):
+    """A run folder of `hnn train data` as the --runs mode reads it."""
+    os.makedirs(folder, exist_ok=True)
+    metrics = dict(task="data", model=model, seed=0, data_file="measured/oscillators.csv",
+                   state_names=["x", "y", "p_x", "p_y"], energy_mse=None,
+                   energy_note="no known Hamiltonian: give one with --hamiltonian EXPR",
+                   valid_prediction_time=1.5 if model == "baseline" else 4.25,
+                   coordinate_mse=2.1e-2 if model == "baseline" else 3.4e-4)
+    if model == "hnn":  # the learned H's spread on the training states: 2.5e-3 / 1e-3
+        metrics.update(learned_h_drift=2.5e-3, learned_h_drift_relative=1e-3)
+    with open(os.path.join(folder, "metrics.json"), "w") as f:
+        json.dump(metrics, f)
+    write_rollout(os.path.join(folder, "rollout.csv"), *data_rollouts(model, **rollout_options))
+    return folder
+
+
 ROLLOUTS = {"spring": spring_rollouts, "two-body": two_body_rollouts,
             "three-body": three_body_rollouts}
 PAPER = {("spring", "baseline"): (3.7134e-2, 3.6656e-2, 1.7077e-1),
@@ -173,8 +218,8 @@ def build_results(root):
 # Tests
 
 
-def run_plot(folder):
-    return subprocess.run([PYTHON, PLOT, folder], capture_output=True, text=True, timeout=300)
+def run_plot(*args):
+    return subprocess.run([PYTHON, PLOT, *args], capture_output=True, text=True, timeout=300)
 
 
 def png_size(path):
@@ -200,6 +245,9 @@ class PlotTest(unittest.TestCase):
         os.makedirs(cls.results)
         build_results(cls.results)
         cls.plotted = run_plot(cls.results)
+        cls.data = os.path.join(cls.root, "data_runs")
+        shutil.rmtree(cls.data, ignore_errors=True)
+        cls.data_runs = [write_data_run(os.path.join(cls.data, m), m) for m in MODELS]
 
     @classmethod
     def tearDownClass(cls):
@@ -287,6 +335,76 @@ class PlotTest(unittest.TestCase):
         run = run_plot(os.path.join(self.root, "does-not-exist"))
         self.assertEqual(run.returncode, 1)
         self.assertIn("not a folder", run.stderr)
+
+    # --runs: Figure 2 of run folders, here of the data task (uneven stretches, d = 4, no H)
+
+    def test_runs_draw_fig2_of_data_runs(self):
+        out = os.path.join(self.data, "figures", "new")  # made if missing
+        run = run_plot("--runs", *self.data_runs, "--out", out)
+        self.assertEqual(run.returncode, 0, run.stderr)
+        self.assertNotIn("Traceback", run.stderr)
+        png, svg = os.path.join(out, "fig2_data.png"), os.path.join(out, "fig2_data.svg")
+        self.assertEqual(run.stdout.split(), [png, svg])
+        width, height = png_size(png)
+        self.assertGreater(width, 600)
+        self.assertGreater(height, 300)
+        self.assertEqual([n for n in os.listdir(out) if n.endswith(".tmp")], [])
+        with open(svg) as f:
+            text = f.read()
+        for words in ("no known Hamiltonian",  # the energy panel says why it has no energy
+                      "p_x",  # q_1 against p_1, named from state_names
+                      "valid pred. time 4.25", "coord. MSE 3.40e-04",  # from metrics.json
+                      "mean while half or more run",  # the stretches differ in length
+                      "spread on the training states",  # the scale of the learned H's drift
+                      "Data from oscillators.csv: test trajectory 2 (the longest of 3),"
+                      " t = 30..35.95"):
+            self.assertTrue(words in text, f"{svg} lacks {words!r}")
+
+    def test_runs_sampled_at_different_times_draw_each_rollout(self):
+        base = write_data_run(os.path.join(self.data, "uneven", "baseline"), "baseline",
+                              steps=(0.05, 0.08, 0.03))
+        out = os.path.join(self.data, "uneven")
+        run = run_plot("--runs", base, "--out", out)
+        self.assertEqual(run.returncode, 0, run.stderr)
+        with open(os.path.join(out, "fig2_data.svg")) as f:
+            text = f.read()
+        self.assertTrue("no mean" in text, "each rollout's own line")
+        self.assertTrue("no HNN run" in text, "nor a learned H: the energy panel says so")
+
+    def test_runs_with_a_broken_or_missing_file_are_an_error_naming_it(self):
+        folder = os.path.join(self.data, "broken")
+        shutil.rmtree(folder, ignore_errors=True)
+        shutil.copytree(self.data_runs[1], folder)
+        path = os.path.join(folder, "rollout.csv")
+        with open(path, "a") as f:
+            f.write("2,36,oops\n")
+        out = os.path.join(self.data, "broken_out")
+        run = run_plot("--runs", self.data_runs[0], folder, "--out", out)
+        self.assertEqual(run.returncode, 1, run.stderr)
+        self.assertIn(path, run.stderr)
+        self.assertNotIn("Traceback", run.stderr)
+        self.assertFalse(os.path.exists(out), "nothing is written")
+        os.remove(path)
+        run = run_plot("--runs", folder, "--out", out)
+        self.assertEqual(run.returncode, 1, run.stderr)
+        self.assertIn(f"{path}: missing", run.stderr)
+
+    def test_runs_of_different_tasks_or_data_are_an_error_naming_them(self):
+        spring = os.path.join(self.results, "spring", "hnn")
+        run = run_plot("--runs", self.data_runs[0], spring, "--out", self.data)
+        self.assertEqual(run.returncode, 1, run.stderr)
+        self.assertIn("different tasks", run.stderr)
+        self.assertIn(f"{self.data_runs[0]} (data)", run.stderr)
+        self.assertIn(f"{spring} (spring)", run.stderr)
+        other = write_data_run(os.path.join(self.data, "other", "hnn"), "hnn",
+                               steps=(0.05, 0.05, 0.06))
+        run = run_plot("--runs", self.data_runs[0], other, "--out", self.data)
+        self.assertEqual(run.returncode, 1, run.stderr)
+        self.assertIn(f"different data: {self.data_runs[0]} and {other}", run.stderr)
+        run = run_plot("--runs", self.data_runs[1], other, "--out", self.data)
+        self.assertEqual(run.returncode, 1, run.stderr)
+        self.assertIn("two hnn runs", run.stderr)
+        self.assertNotIn("Traceback", run.stderr)
 
 
 if __name__ == "__main__":
