@@ -212,6 +212,31 @@ class DataRun : public FieldModelRun {
     return csv;
   }
 
+  // The units folded into the weights: the first layer takes x instead of z = (x - mean) / scale
+  // and the last gives H in the file's units (an HNN) or dx/dt (a baseline). Exact: an affine map
+  // into a linear layer is a linear layer.
+  std::unique_ptr<nn::DynamicsModel<double>> model_in_data_units() const override {
+    std::unique_ptr<nn::DynamicsModel<double>> m = nn::cast_model<double>(dynamics());
+    const Units& u = p_.units;
+    const std::size_t layers = m->config().hidden.size() + 1;
+    const Eigen::RowVectorXd output_scale =
+        m->config().model == nn::ModelKind::kHnn
+            ? Eigen::RowVectorXd::Constant(m->mlp().config().widths.back(), u.energy_to_file())
+            : Eigen::RowVectorXd(u.scale / u.time);
+    nn::Matrix<double> first_weight;
+    m->visit_parameters([&](const std::string& name, ad::Var<double>& p) {
+      nn::Matrix<double>& v = p.mutable_value();
+      if (name == "mlp.layers.0.weight") {
+        first_weight = v;  // the bias below needs it unscaled
+        v = u.scale.cwiseInverse().asDiagonal() * v;
+      }
+      if (name == "mlp.layers.0.bias") v -= u.mean.cwiseQuotient(u.scale) * first_weight;
+      const std::string last = fmt::format("mlp.layers.{}.", layers - 1);
+      if (name.starts_with(last)) v = v * output_scale.asDiagonal();
+    });
+    return m;
+  }
+
   // Test states spread over the held-out rows, in the model's units.
   Batch rollout_states(int count) const override { return spread_rows(data_.test_x, count); }
 

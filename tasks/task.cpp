@@ -4,6 +4,7 @@
 #include <functional>
 #include <utility>
 
+#include "nn/hnn.h"
 #include "tasks/experiments.h"
 
 namespace hnn::tasks {
@@ -29,6 +30,10 @@ const std::vector<std::pair<std::string, Factory>>& registry() {
 void Task::check_task_settings(const nlohmann::json& settings) const {
   HNN_TASKS_CHECK(settings.empty(), "task '{}' has no settings of its own, got {}", name(),
                   settings.dump());
+}
+
+std::unique_ptr<nn::DynamicsModel<double>> TaskRun::model_in_data_units() const {
+  return nn::cast_model<double>(dynamics());
 }
 
 void Task::write_comparison(const std::filesystem::path&, const std::filesystem::path&,

@@ -57,6 +57,9 @@ class TaskRun {
   virtual double rollout_span() const = 0;
   /// "state" (phase space) or "latent".
   virtual std::string space() const { return "state"; }
+  /// The trained model as a user sees it, for `hnn export`: in the data's own units (a task
+  /// that trains in other units folds them into the weights). By default dynamics() in double.
+  virtual std::unique_ptr<nn::DynamicsModel<double>> model_in_data_units() const;
 };
 
 class Task {

@@ -19,7 +19,9 @@ struct ExportOptions {
 void run_export(const ExportOptions& o) {
   const nn::ExportFormat format = nn::parse_export_format(o.format);
   const tasks::LoadedRun loaded = tasks::load_run(o.run);
-  const nn::DynamicsModel<double>& model = loaded.run->dynamics();
+  const std::unique_ptr<nn::DynamicsModel<double>> in_data_units =
+      loaded.run->model_in_data_units();
+  const nn::DynamicsModel<double>& model = *in_data_units;
   const std::string source =
       fmt::format("run {} (task {}, seed {})", o.run, loaded.task->name(), loaded.settings.seed);
   tasks::write_file_atomic(o.out, nn::export_model(model, format, source));

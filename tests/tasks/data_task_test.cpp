@@ -117,6 +117,20 @@ TEST(DataTask, TrainsOnACsvAndEvaluatesOnHeldOutTrajectories) {
   // A loaded run evaluates to the same numbers.
   const nlohmann::json again = evaluate_run(dir / "hnn", "", false);
   EXPECT_DOUBLE_EQ(again["test_loss"].get<double>(), m["test_loss"].get<double>());
+
+  // What `hnn export` writes: the model with the units folded in, whose field in the file's
+  // units is the trained model's field carried through the units.
+  const LoadedRun loaded = load_run(dir / "hnn");
+  Units u = identity_units(4);
+  for (int c = 0; c < 4; ++c) {
+    u.mean(c) = m["units"]["mean"][c];
+    u.scale(c) = m["units"]["scale"][c];
+  }
+  u.time = m["units"]["time"];
+  const Batch x = Batch::Random(7, 4);
+  const Batch expected = u.rate_to_file(loaded.run->dynamics().field(u.to_model(x)));
+  const Batch folded = loaded.run->model_in_data_units()->field(x);
+  EXPECT_LT((folded - expected).norm(), 1e-12 * expected.norm());
 }
 
 // Without a known H there is no energy MSE, and the metrics say why.
