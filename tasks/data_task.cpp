@@ -34,9 +34,9 @@ struct DataConfig {
 
 const std::vector<std::string>& setting_names() {
   static const std::vector<std::string> names = {
-      "coords",         "momenta",   "velocities",      "derivatives",    "time",
-      "trajectory",     "split",     "test_fraction",   "gap_factor",     "hamiltonian",
-      "standardize",    "threshold", "energy_rollouts", "energy_t_end"};
+      "coords",      "momenta",   "velocities",      "derivatives", "time",
+      "trajectory",  "split",     "test_fraction",   "gap_factor",  "hamiltonian",
+      "standardize", "threshold", "energy_rollouts", "energy_t_end"};
   return names;
 }
 
@@ -146,8 +146,8 @@ Prepared prepare(const RunSettings& s) {
   Prepared p{.config = data_config(s.task_settings)};
   p.measured = load_measured_data(s.data_file, p.config.measured);
   HNN_TASKS_CHECK(p.measured.data.train_x.rows() >= 2 && p.measured.data.test_x.rows() >= 1,
-                  "{}: {} training and {} test rows: too few to train and test",
-                  p.measured.source, p.measured.data.train_x.rows(), p.measured.data.test_x.rows());
+                  "{}: {} training and {} test rows: too few to train and test", p.measured.source,
+                  p.measured.data.train_x.rows(), p.measured.data.test_x.rows());
   p.units = p.config.standardize
                 ? fit_units(p.measured.data, p.measured.coordinates, p.measured.state_names)
                 : identity_units(p.measured.data.train_x.cols());
@@ -166,11 +166,14 @@ class DataRun : public FieldModelRun {
     const Dataset& d = p_.measured.data;
     const nn::MeanStderr train = loss_stats(file.field, d.train_x, d.train_dxdt);
     const nn::MeanStderr test = loss_stats(file.field, d.test_x, d.test_dxdt);
-    json m = {{"train_loss", number(train.mean)}, {"train_loss_se", number(train.std_error)},
-              {"test_loss", number(test.mean)},   {"test_loss_se", number(test.std_error)},
+    json m = {{"train_loss", number(train.mean)},
+              {"train_loss_se", number(train.std_error)},
+              {"test_loss", number(test.mean)},
+              {"test_loss_se", number(test.std_error)},
               {"train_r2", number(r_squared(train.mean, d.train_dxdt))},
               {"test_r2", number(r_squared(test.mean, d.test_dxdt))},
-              {"n_train", d.train_x.rows()},      {"n_test", d.test_x.rows()}};
+              {"n_train", d.train_x.rows()},
+              {"n_test", d.test_x.rows()}};
     const HeldOutEvaluation held = evaluate_held_out(
         model, p_.units, p_.measured.held_out, p_.measured.coordinates, data_.train_x,
         {.threshold = p_.config.threshold, .truth = p_.truth.get()});
@@ -201,13 +204,14 @@ class DataRun : public FieldModelRun {
     for (std::size_t i = 0; i < held.size() && int(i) < r.trajectories; ++i) {
       append_rows(csv, "data", i, (held[i].t.array() - held[i].t(0)).matrix(), held[i].x,
                   std::nullopt);
-      const Batch z = integrator->integrate(model.field, u.to_model(Batch(held[i].x.topRows(1))),
-                                            t_model).path(0);
+      const Batch z =
+          integrator->integrate(model.field, u.to_model(Batch(held[i].x.topRows(1))), t_model)
+              .path(0);
       std::optional<Eigen::VectorXd> h;
       if (model.hamiltonian) h = model.hamiltonian(z) * u.energy_to_file();
       append_rows(csv, nn::to_string(s_.model), i,
-                  Eigen::Map<const Eigen::VectorXd>(t.data(), Eigen::Index(t.size())),
-                  u.to_file(z), h);
+                  Eigen::Map<const Eigen::VectorXd>(t.data(), Eigen::Index(t.size())), u.to_file(z),
+                  h);
     }
     return csv;
   }
@@ -260,16 +264,12 @@ class DataRun : public FieldModelRun {
     }
     const double t_end = p_.config.energy_t_end > 0 ? p_.config.energy_t_end : held_out_duration();
     const RolloutConfig config{.trajectories = p_.config.energy_rollouts, .t_end = t_end};
-    const Rollouts r = make_rollouts(*p_.truth, file,
-                                     spread_rows(p_.measured.data.test_x, config.trajectories),
-                                     config);
+    const Rollouts r = make_rollouts(
+        *p_.truth, file, spread_rows(p_.measured.data.test_x, config.trajectories), config);
     const nn::MeanStderr e = energy_mse(r);
-    return {{"energy_mse", number(e.mean)},
-            {"energy_mse_se", number(e.std_error)},
-            {"n_rollouts", e.count},
-            {"rollout_failures", r.failures},
-            {"energy_t_end", t_end},
-            {"hamiltonian", p_.config.hamiltonian}};
+    return {{"energy_mse", number(e.mean)}, {"energy_mse_se", number(e.std_error)},
+            {"n_rollouts", e.count},        {"rollout_failures", r.failures},
+            {"energy_t_end", t_end},        {"hamiltonian", p_.config.hamiltonian}};
   }
 
   // Rows source,traj,t,x..,energy (with a known H),learned_h (with h).

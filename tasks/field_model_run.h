@@ -36,7 +36,8 @@ class FieldModelRun : public TaskRun {
  protected:
   /// Checks the batch size against the data before a run folder exists: a bad one leaves
   /// nothing behind.
-  FieldModelRun(RunSettings settings, Dataset data) : s_(std::move(settings)), data_(std::move(data)) {
+  FieldModelRun(RunSettings settings, Dataset data)
+      : s_(std::move(settings)), data_(std::move(data)) {
     HNN_TASKS_CHECK(s_.train.batch_size <= data_.train_x.rows(),
                     "--batch {} is larger than the training set ({} rows)", s_.train.batch_size,
                     data_.train_x.rows());

@@ -108,7 +108,13 @@ namespace {
 std::vector<RunOptions> plan_runs(const ReproduceOptions& o,
                                   const std::vector<std::string>& tasks) {
   std::vector<RunOptions> runs;
+  const std::vector<std::string> paper = paper_task_names();
   for (const std::string& task : tasks) {
+    make_task(task);  // an unknown name: the known ones
+    HNN_TASKS_CHECK(std::find(paper.begin(), paper.end(), task) != paper.end(),
+                    "reproduce runs the paper's tasks ({}); '{}' is not one of them: train it "
+                    "with hnn train {}",
+                    fmt::join(paper, ", "), task, task);
     for (const nn::ModelKind model : kModels) {
       for (int seed = 0; seed < o.seeds; ++seed) {
         RunOptions r{.task = task,

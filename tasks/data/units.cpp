@@ -43,8 +43,8 @@ Units fit_units(const Dataset& data, Eigen::Index coordinates,
   const Batch& x = data.train_x;
   const Eigen::Index dim = x.cols();
   HNN_TASKS_CHECK(x.rows() >= 2 && dim == 2 * coordinates && Eigen::Index(names.size()) == dim,
-                  "units: {} training rows of {} columns for {} coordinates and {} names",
-                  x.rows(), dim, coordinates, names.size());
+                  "units: {} training rows of {} columns for {} coordinates and {} names", x.rows(),
+                  dim, coordinates, names.size());
   Units u;
   u.mean = x.colwise().mean();
   u.scale = ((x.rowwise() - u.mean).colwise().squaredNorm() / double(x.rows() - 1)).cwiseSqrt();
@@ -63,8 +63,8 @@ Units fit_units(const Dataset& data, Eigen::Index coordinates,
     u.scale(i) *= factor;
     u.scale(coordinates + i) *= factor;
   }
-  const double rms = std::sqrt(
-      (data.train_dxdt.array().rowwise() / u.scale.array()).square().mean());
+  const double rms =
+      std::sqrt((data.train_dxdt.array().rowwise() / u.scale.array()).square().mean());
   HNN_TASKS_CHECK(rms > 0 && std::isfinite(rms),
                   "dx/dt is zero (or not finite) over the whole training split: nothing moves");
   u.time = 1 / rms;

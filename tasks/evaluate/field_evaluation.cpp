@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "nn/hnn.h"
+#include "tasks/report/csv_cell.h"
 #include "tasks/report/json_values.h"
 
 namespace hnn::tasks {
@@ -41,15 +42,13 @@ FieldEvaluation evaluate_field_model(const physics::System& truth,
 
 namespace {
 
-std::string cell(double v) { return std::isfinite(v) ? fmt::format("{:.12g}", v) : ""; }
-
 std::string rollout_row(const Rollouts& r, std::size_t i, std::size_t k) {
   const Eigen::Index row = Eigen::Index(k), traj = Eigen::Index(i);
   std::string line = fmt::format("{},{:.9g}", i, r.t[k]);
-  for (Eigen::Index c = 0; c < r.truth[i].cols(); ++c) line += "," + cell(r.truth[i](row, c));
-  for (Eigen::Index c = 0; c < r.pred[i].cols(); ++c) line += "," + cell(r.pred[i](row, c));
-  line += "," + cell(r.true_energy(traj, row)) + "," + cell(r.pred_energy(traj, row)) + ",";
-  if (r.learned_h.size() > 0) line += cell(r.learned_h(traj, row));
+  for (Eigen::Index c = 0; c < r.truth[i].cols(); ++c) line += "," + csv_cell(r.truth[i](row, c));
+  for (Eigen::Index c = 0; c < r.pred[i].cols(); ++c) line += "," + csv_cell(r.pred[i](row, c));
+  line += "," + csv_cell(r.true_energy(traj, row)) + "," + csv_cell(r.pred_energy(traj, row)) + ",";
+  if (r.learned_h.size() > 0) line += csv_cell(r.learned_h(traj, row));
   return line + "\n";
 }
 

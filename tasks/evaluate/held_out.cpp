@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "physics/integrator.h"
+#include "tasks/report/csv_cell.h"
 #include "tasks/report/json_values.h"
 
 namespace hnn::tasks {
@@ -83,10 +84,13 @@ HeldOutEvaluation evaluate_held_out(const LearnedField& model, const Units& unit
   double h_spread = NAN;
   if (model.hamiltonian) {
     const Eigen::VectorXd h = model.hamiltonian(train_z) * units.energy_to_file();
-    h_spread = std::sqrt((h.array() - h.mean()).square().sum() / double(std::max<Eigen::Index>(1, h.size() - 1)));
+    h_spread = std::sqrt((h.array() - h.mean()).square().sum() /
+                         double(std::max<Eigen::Index>(1, h.size() - 1)));
   }
   for (const HeldOut& stretch : held_out) {
-    HeldOutRollout r{.trajectory = stretch.trajectory, .where = stretch.where, .t = stretch.t,
+    HeldOutRollout r{.trajectory = stretch.trajectory,
+                     .where = stretch.where,
+                     .t = stretch.t,
                      .truth = stretch.x};
     roll_out(model, units, r);
     valid_time(units, options.threshold, r);
@@ -97,8 +101,7 @@ HeldOutEvaluation evaluate_held_out(const LearnedField& model, const Units& unit
     if (r.failed) {
       failures.push_back(r.failure);
     } else {
-      const Eigen::ArrayXXd sq =
-          (r.pred - r.truth).leftCols(coordinates).array().square();
+      const Eigen::ArrayXXd sq = (r.pred - r.truth).leftCols(coordinates).array().square();
       mse.push_back(sq.mean());
       sum += sq.sum();
       count += double(sq.size());
@@ -128,8 +131,6 @@ HeldOutEvaluation evaluate_held_out(const LearnedField& model, const Units& unit
 
 namespace {
 
-std::string cell(double v) { return std::isfinite(v) ? fmt::format("{:.12g}", v) : ""; }
-
 double at(const Eigen::VectorXd& v, Eigen::Index k) { return v.size() > k ? v(k) : NAN; }
 
 }  // namespace
@@ -144,10 +145,10 @@ std::string held_out_csv(const HeldOutEvaluation& e) {
     const HeldOutRollout& r = e.rollouts[i];
     for (Eigen::Index k = 0; k < r.t.size(); ++k) {
       csv += fmt::format("{},{:.12g}", i, r.t(k));
-      for (Eigen::Index c = 0; c < dim; ++c) csv += "," + cell(r.truth(k, c));
-      for (Eigen::Index c = 0; c < dim; ++c) csv += "," + cell(r.pred(k, c));
-      csv += fmt::format(",{},{},{}\n", cell(at(r.true_energy, k)), cell(at(r.pred_energy, k)),
-                         cell(at(r.learned_h, k)));
+      for (Eigen::Index c = 0; c < dim; ++c) csv += "," + csv_cell(r.truth(k, c));
+      for (Eigen::Index c = 0; c < dim; ++c) csv += "," + csv_cell(r.pred(k, c));
+      csv += fmt::format(",{},{},{}\n", csv_cell(at(r.true_energy, k)),
+                         csv_cell(at(r.pred_energy, k)), csv_cell(at(r.learned_h, k)));
     }
   }
   return csv;

@@ -16,13 +16,13 @@ namespace hnn::tasks {
 
 struct HeldOutRollout {
   double trajectory = 0;
-  std::string where{};  ///< the stretch's first row in the file
-  Eigen::VectorXd t{};  ///< the file's times
+  std::string where{};    ///< the stretch's first row in the file
+  Eigen::VectorXd t{};    ///< the file's times
   Batch truth{}, pred{};  ///< measured and predicted states, file units (pred NaN when failed)
-  Eigen::VectorXd learned_h{};               ///< the model's H along pred, file units; or empty
+  Eigen::VectorXd learned_h{};                   ///< the model's H along pred, file units; or empty
   Eigen::VectorXd true_energy{}, pred_energy{};  ///< a known H of truth and pred; or empty
-  double valid_time = 0;                     ///< time since the start until the error threshold
-  bool censored = false;                     ///< the error never passed it: a lower bound
+  double valid_time = 0;                         ///< time since the start until the error threshold
+  bool censored = false;                         ///< the error never passed it: a lower bound
   bool failed = false;
   std::string failure{};
 };

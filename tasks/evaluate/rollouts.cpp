@@ -53,12 +53,13 @@ nn::MeanStderr loss_stats(const physics::VectorField& field, const Batch& x, con
 }
 
 LearnedField learned_field(const nn::DynamicsModel<double>& model) {
-  LearnedField learned{.field = [&model](double, const Batch& x, Batch& dxdt) {
-    dxdt = model.field(x);
-  }};
+  LearnedField learned{
+      .field = [&model](double, const Batch& x, Batch& dxdt) { dxdt = model.field(x); }};
   const auto* hnn = dynamic_cast<const nn::Hnn<double>*>(&model);
   if (hnn != nullptr && model.config().field != nn::FieldType::kConservative)
-    learned.hamiltonian = [hnn](const Batch& x) -> Eigen::VectorXd { return hnn->energy(x).col(0); };
+    learned.hamiltonian = [hnn](const Batch& x) -> Eigen::VectorXd {
+      return hnn->energy(x).col(0);
+    };
   return learned;
 }
 

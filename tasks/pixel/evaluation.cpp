@@ -11,6 +11,7 @@
 #include "physics/integrator.h"
 #include "tasks/pixel/figures.h"
 #include "tasks/pixel/rollouts.h"
+#include "tasks/report/csv_cell.h"
 #include "tasks/report/json_values.h"
 
 namespace hnn::tasks::pixel {
@@ -23,8 +24,6 @@ json stats_json(const nn::MeanStderr& s) {
   return {{"mean", number(s.mean)}, {"se", number(s.std_error)}};
 }
 
-std::string cell(double v) { return std::isfinite(v) ? fmt::format("{:.9g}", v) : ""; }
-
 double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
@@ -35,13 +34,15 @@ std::string rollout_csv(const PixelRollouts& r) {
       "frames_energy,z_q,z_p,learned_h,pair_energy\n";
   for (Eigen::Index i = 0; i < r.true_energy.rows(); ++i) {
     for (Eigen::Index k = 0; k < Eigen::Index(r.t.size()); ++k) {
-      csv +=
-          fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", i, r.t[std::size_t(k)],
-                      cell(r.frame_mse(i, k)), cell(r.true_theta(i, k)), cell(r.true_p(i, k)),
-                      cell(r.true_energy(i, k)), cell(r.pred_theta(i, k)), cell(r.pred_p(i, k)),
-                      cell(r.pred_energy(i, k)), cell(r.frames_energy(i, k)),
-                      cell(r.z[std::size_t(i)](k, 0)), cell(r.z[std::size_t(i)](k, 1)),
-                      r.learned_h.size() ? cell(r.learned_h(i, k)) : "", cell(r.pair_energy(i, k)));
+      csv += fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", i, r.t[std::size_t(k)],
+                         csv_cell(r.frame_mse(i, k), 9), csv_cell(r.true_theta(i, k), 9),
+                         csv_cell(r.true_p(i, k), 9), csv_cell(r.true_energy(i, k), 9),
+                         csv_cell(r.pred_theta(i, k), 9), csv_cell(r.pred_p(i, k), 9),
+                         csv_cell(r.pred_energy(i, k), 9), csv_cell(r.frames_energy(i, k), 9),
+                         csv_cell(r.z[std::size_t(i)](k, 0), 9),
+                         csv_cell(r.z[std::size_t(i)](k, 1), 9),
+                         r.learned_h.size() ? csv_cell(r.learned_h(i, k), 9) : "",
+                         csv_cell(r.pair_energy(i, k), 9));
     }
   }
   return csv;
@@ -175,8 +176,8 @@ std::string pixel_rollout_csv(const PixelModel<double>& model, const PixelData& 
       const Eigen::RowVector2d x = state_from_frames(scene, pairs.row(k).head(kFramePixels),
                                                      pairs.row(k + 1).head(kFramePixels));
       csv += fmt::format("{},{},{},{:.9g},{:.9g},{},{},{},{}\n", model_name, i, t[std::size_t(k)],
-                         z(k, 0), z(k, 1), cell(x(0)), cell(x(1)), cell(scene.energy(x)),
-                         h.size() ? cell(h(k)) : "");
+                         z(k, 0), z(k, 1), csv_cell(x(0), 9), csv_cell(x(1), 9),
+                         csv_cell(scene.energy(x), 9), h.size() ? csv_cell(h(k), 9) : "");
     }
   }
   return csv;

@@ -9,6 +9,7 @@
 
 #include "tasks/error.h"
 #include "tasks/pixel/rollouts.h"
+#include "tasks/report/csv_cell.h"
 #include "tasks/report/image_io.h"
 
 namespace hnn::tasks::pixel {
@@ -22,8 +23,6 @@ constexpr int kGap = 2;       // pixels between tiles
 constexpr int kGifScale = 3;  // each frame pixel as a 3 x 3 block in the GIF
 constexpr int kStripScale = 2;
 constexpr int kGifDelay = 5;  // hundredths of a second: Gym's dt, so the GIF runs in real time
-
-std::string cell(double v) { return std::isfinite(v) ? fmt::format("{:.9g}", v) : ""; }
 
 }  // namespace
 
@@ -98,7 +97,7 @@ void write_latent_files(const PixelModel<double>& model, const PixelData& data,
   std::string csv = "z_q,z_p,learned_h,dz_q,dz_p\n";
   for (Eigen::Index k = 0; k < grid.rows(); ++k) {
     csv += fmt::format("{:.9g},{:.9g},{},{:.9g},{:.9g}\n", grid(k, 0), grid(k, 1),
-                       h.size() ? cell(h(k)) : "", f(k, 0), f(k, 1));
+                       h.size() ? csv_cell(h(k), 9) : "", f(k, 0), f(k, 1));
   }
   folder.write_text("latent_grid.csv", csv);
 }

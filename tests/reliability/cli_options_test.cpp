@@ -139,7 +139,10 @@ TEST(CliOptions, BadCommandsAndOtherSubcommandsGetOneLine) {
        "Could not convert: --no-reversibility = x"},
       {{"reproduce", "--tasks", "spring,nope", "--out", (dir / "results").string()},
        "unknown task 'nope' (known: spring, pendulum, real-pendulum, two-body, three-body, "
-       "pixel-pendulum)"},
+       "pixel-pendulum, data)"},
+      {{"reproduce", "--tasks", "data", "--out", (dir / "results").string()},
+       "reproduce runs the paper's tasks (spring, pendulum, real-pendulum, two-body, three-body, "
+       "pixel-pendulum); 'data' is not one of them: train it with hnn train data"},
       {{"bump", dir.path().string(), "--before", "0"},
        "--before: expected a finite number > 0, got '0'"},
       {{"bump", dir.path().string(), "--dt", "nan"},

@@ -32,8 +32,8 @@ void write_oscillators(const std::filesystem::path& path, const std::array<doubl
       const double t = 3.0 * i / 24;
       const double q1 = a1 * std::cos(2 * t + f1), p1 = -2 * a1 * std::sin(2 * t + f1);
       const double q2 = a2 * std::cos(t + f2), p2 = -a2 * std::sin(t + f2);
-      out << k << ',' << t << ',' << q1 * scale[0] << ',' << q2 * scale[1] << ','
-          << p1 * scale[2] << ',' << p2 * scale[3] << '\n';
+      out << k << ',' << t << ',' << q1 * scale[0] << ',' << q2 * scale[1] << ',' << p1 * scale[2]
+          << ',' << p2 * scale[3] << '\n';
     }
   }
 }
@@ -77,7 +77,8 @@ TEST(Units, KeepAFieldHamiltonian) {
     minus.col(c).array() -= eps;
     const Eigen::VectorXd dh = (h_model(plus) - h_model(minus)) / (2 * eps);
     // dz/dt' = (dH'/dp', -dH'/dq')
-    const Eigen::VectorXd expected = c < 2 ? Eigen::VectorXd(-dzdt.col(c + 2)) : Eigen::VectorXd(dzdt.col(c - 2));
+    const Eigen::VectorXd expected =
+        c < 2 ? Eigen::VectorXd(-dzdt.col(c + 2)) : Eigen::VectorXd(dzdt.col(c - 2));
     EXPECT_LT((dh - expected).norm(), 1e-5 * (1 + expected.norm())) << "column " << c;
   }
 }
@@ -91,7 +92,8 @@ TEST(Units, RefuseAConstantColumnByName) {
     fit_units(d, 1, {"x", "v"});
     FAIL() << "a constant column was accepted";
   } catch (const Error& e) {
-    EXPECT_STREQ(e.what(), "column 'v' is constant over the training split: nothing to learn from it");
+    EXPECT_STREQ(e.what(),
+                 "column 'v' is constant over the training split: nothing to learn from it");
   }
 }
 
@@ -177,8 +179,8 @@ TEST(DataTask, RefusesBadSettingsByName) {
   TempDir dir("data");
   write_oscillators(dir / "osc.csv", {1, 1, 1, 1});
   const auto message = [&](const nlohmann::json& settings, std::string file = "") {
-    RunOptions o = data_run(file.empty() ? dir / "osc.csv" : std::filesystem::path(file),
-                            dir / "bad");
+    RunOptions o =
+        data_run(file.empty() ? dir / "osc.csv" : std::filesystem::path(file), dir / "bad");
     o.data_file = file == "none" ? "" : o.data_file;
     o.task_settings.update(settings);
     try {
