@@ -2,7 +2,8 @@
 # The results the data task must hold (issue 17), measured from scratch: three Hamiltonians the
 # paper lacks simulated by `hnn simulate`, each learned by an HNN and a baseline through
 # `hnn train data`, and copies of their files in other units (x100, x0.01); and the shipped real
-# pendulum through the data task beside the real-pendulum task. Writes OUT/results.md.
+# pendulum through the data task beside the real-pendulum task. Writes OUT/results.md and
+# Figure 2 of each system's seed-0 pair into OUT/charts/NAME/.
 # Usage: scripts/data_results.sh [OUT]   (default results/data; about 15 minutes on 2 cores)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -65,6 +66,10 @@ for seed in $(seq 0 $((seeds - 1))); do
       --settings '{"energy_t_end": 20}' --model "$model" --seed "$seed" --quiet \
       --out "$out/runs/real-pendulum-central/$model/seed-$seed" >/dev/null
   done
+done
+for name in nonseparable henon-heiles double-well real-pendulum-central; do
+  /usr/bin/python3 scripts/plot.py --runs "$out/runs/$name/hnn/seed-0" \
+    "$out/runs/$name/baseline/seed-0" --out "$out/charts/$name" >/dev/null
 done
 /usr/bin/python3 scripts/data_results.py "$out" >"$out/results.md"
 cat "$out/results.md"
