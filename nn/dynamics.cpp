@@ -9,9 +9,10 @@ namespace hnn::nn {
 
 namespace {
 
-constexpr std::array<std::pair<ModelKind, std::string_view>, 2> kKindNames{{
+constexpr std::array<std::pair<ModelKind, std::string_view>, 3> kKindNames{{
     {ModelKind::kHnn, "hnn"},
     {ModelKind::kBaseline, "baseline"},
+    {ModelKind::kDhnn, "dhnn"},
 }};
 constexpr std::array<std::pair<FieldType, std::string_view>, 3> kFieldNames{{
     {FieldType::kSolenoidal, "solenoidal"},
@@ -51,7 +52,12 @@ void validate(const DynamicsConfig& config) {
   if (config.dim < 1) {
     throw std::invalid_argument(fmt::format("model: state dimension {} must be >= 1", config.dim));
   }
-  if (config.model == ModelKind::kHnn && config.dim % 2 != 0 &&
+  if (config.model == ModelKind::kDhnn && config.field != FieldType::kBoth) {
+    throw std::invalid_argument(
+        fmt::format("model: a dhnn learns H and D (field type 'both'), got field type '{}'",
+                    to_string(config.field)));
+  }
+  if (learns_scalars(config.model) && config.dim % 2 != 0 &&
       config.field != FieldType::kConservative) {
     throw std::invalid_argument(
         fmt::format("model: an HNN needs an even state dimension x = (q, p), got {}", config.dim));
@@ -64,7 +70,7 @@ MlpConfig mlp_config(const DynamicsConfig& config) {
   mlp.widths.push_back(config.dim);
   mlp.widths.insert(mlp.widths.end(), config.hidden.begin(), config.hidden.end());
   Index out = config.dim;
-  if (config.model == ModelKind::kHnn) out = config.field == FieldType::kBoth ? 2 : 1;
+  if (learns_scalars(config.model)) out = config.field == FieldType::kBoth ? 2 : 1;
   mlp.widths.push_back(out);
   mlp.activation = config.activation;
   mlp.init = config.init;

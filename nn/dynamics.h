@@ -14,6 +14,7 @@ namespace hnn::nn {
 enum class ModelKind {
   kHnn,       // a learned scalar; dx/dt from its derivatives (the field type below)
   kBaseline,  // an MLP that outputs dx/dt directly
+  kDhnn,      // the dissipative HNN (Sosanya & Greydanus 2022): an HNN whose field type is kBoth
 };
 
 /// How an HNN turns learned scalars into a field (the reference's field_type).
@@ -23,7 +24,10 @@ enum class FieldType {
   kBoth,          // (dH/dp, -dH/dq) + dD/dx: the dissipative extension (friction)
 };
 
-/// "hnn", "baseline"; "solenoidal", "conservative", "both".
+/// Whether a model of this kind is an Hnn (learns scalars whose gradients give the field).
+inline bool learns_scalars(ModelKind kind) { return kind != ModelKind::kBaseline; }
+
+/// "hnn", "baseline", "dhnn"; "solenoidal", "conservative", "both".
 std::string_view to_string(ModelKind kind);
 std::string_view to_string(FieldType field);
 /// Inverses of to_string; throw std::invalid_argument listing the valid names.
@@ -38,7 +42,7 @@ struct DynamicsConfig {
   std::vector<Index> hidden = {200, 200};
   Activation activation = Activation::kTanh;
   Init init = Init::kOrthogonal;
-  FieldType field = FieldType::kSolenoidal;  // HNN only
+  FieldType field = FieldType::kSolenoidal;  // HNN only; a kDhnn's must be kBoth
 };
 
 /// The MLP of a model: dim -> hidden... -> out, with out = dim for the baseline and the number of

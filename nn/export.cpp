@@ -210,7 +210,7 @@ ExportFormat parse_export_format(std::string_view name) {
 
 void check_exportable(const DynamicsModel<double>& model) {
   const DynamicsConfig& config = model.config();
-  if (config.model != ModelKind::kHnn || !dynamic_cast<const Hnn<double>*>(&model)) {
+  if (!learns_scalars(config.model) || !dynamic_cast<const Hnn<double>*>(&model)) {
     throw std::invalid_argument("cannot export a baseline model: it has no learned H");
   }
   if (config.field != FieldType::kSolenoidal) {

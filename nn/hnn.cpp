@@ -11,8 +11,9 @@ namespace hnn::nn {
 
 namespace {
 
+// An Hnn is built from a kHnn or kDhnn config, a Baseline from a kBaseline one.
 const DynamicsConfig& require(const DynamicsConfig& config, ModelKind kind) {
-  if (config.model != kind) {
+  if (learns_scalars(config.model) != learns_scalars(kind)) {
     throw std::invalid_argument(fmt::format("a {} model cannot be built from a '{}' config",
                                             to_string(kind), to_string(config.model)));
   }
@@ -133,14 +134,14 @@ Matrix<T> Baseline<T>::field(const Matrix<T>& x) const {
 
 template <typename T>
 std::unique_ptr<DynamicsModel<T>> make_model(const DynamicsConfig& config, std::mt19937_64& rng) {
-  if (config.model == ModelKind::kHnn) return std::make_unique<Hnn<T>>(config, rng);
+  if (learns_scalars(config.model)) return std::make_unique<Hnn<T>>(config, rng);
   return std::make_unique<Baseline<T>>(config, rng);
 }
 
 template <typename U, typename T>
 std::unique_ptr<DynamicsModel<U>> cast_model(const DynamicsModel<T>& model) {
   Mlp<U> mlp = model.mlp().template cast<U>();
-  if (model.config().model == ModelKind::kHnn) {
+  if (learns_scalars(model.config().model)) {
     return std::make_unique<Hnn<U>>(model.config(), std::move(mlp));
   }
   return std::make_unique<Baseline<U>>(model.config(), std::move(mlp));

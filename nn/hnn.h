@@ -23,7 +23,7 @@ class Hnn : public DynamicsModel<T> {
     ad::Var<T> conservative;  // dD/dx
   };
 
-  /// config.model must be kHnn. Parameters initialised from `rng`.
+  /// config.model must be kHnn or kDhnn. Parameters initialised from `rng`.
   Hnn(DynamicsConfig config, std::mt19937_64& rng);
   /// An HNN with the given MLP, which must match mlp_config(config).
   Hnn(DynamicsConfig config, Mlp<T> mlp);

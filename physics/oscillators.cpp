@@ -32,6 +32,38 @@ Batch Spring::sample_initial_states(int n, std::mt19937_64& rng) const {
   return sample_on_annulus(n, 0.1, 1.0, rng);
 }
 
+DampedSpring::DampedSpring(double rho) : rho_(rho) {
+  require_positive(rho, "DampedSpring damping rho");
+}
+
+Eigen::VectorXd DampedSpring::hamiltonian_batch(const Batch& x) const {
+  return (x.col(0).array().square() + x.col(1).array().square()).matrix();
+}
+
+Batch DampedSpring::conservative_part(const Batch& x) const {
+  Batch f(x.rows(), 2);
+  f.col(0) = 2.0 * x.col(1);
+  f.col(1) = -2.0 * x.col(0);
+  return f;
+}
+
+Batch DampedSpring::dissipative_part(const Batch& x) const {
+  Batch f = Batch::Zero(x.rows(), 2);
+  f.col(0) = -rho_ * x.col(0);
+  return f;
+}
+
+void DampedSpring::vector_field(const Batch& x, Batch& dxdt) const {
+  dxdt = conservative_part(x) + dissipative_part(x);
+}
+
+Batch DampedSpring::sample_initial_states(int n, std::mt19937_64& rng) const {
+  std::uniform_real_distribution<double> u(-1.2, 1.2);
+  Batch x(n, 2);
+  for (Eigen::Index i = 0; i < x.size(); ++i) x.data()[i] = u(rng);
+  return x;
+}
+
 double Spring::omega() const { return 2.0 * std::sqrt(stiffness_ * kinetic_); }
 
 std::optional<Batch> Spring::exact_flow(const Batch& x0, double t) const {

@@ -52,6 +52,28 @@ class Pendulum : public SeparableSystem {
   double kinetic_;
 };
 
+/// The damped spring of the dissipative-HNN paper (Sosanya & Greydanus 2022): the spring's
+/// H = q^2 + p^2 plus the gradient field dD/dx of D = -rho q^2 / 2 (their code damps the
+/// coordinate): dq/dt = 2p - rho q, dp/dt = -2q. Not conservative: hamiltonian_batch is the H
+/// of its conservative part, which decays along the flow.
+class DampedSpring : public System {
+ public:
+  explicit DampedSpring(double rho = 2.0);
+
+  int dim() const override { return 2; }
+  std::string name() const override { return "damped-spring"; }
+  Eigen::VectorXd hamiltonian_batch(const Batch& x) const override;
+  void vector_field(const Batch& x, Batch& dxdt) const override;
+  /// The two parts of the field: (dH/dp, -dH/dq) and dD/dx.
+  Batch conservative_part(const Batch& x) const;
+  Batch dissipative_part(const Batch& x) const;
+  /// Uniform in [-1.2, 1.2]^2 (the paper's grid range).
+  Batch sample_initial_states(int n, std::mt19937_64& rng) const override;
+
+ private:
+  double rho_;
+};
+
 /// n states as the reference samples tasks 1-2: a direction uniform in
 /// [-1,1]^2, normalised to a radius uniform in [r_lo, r_hi].
 Batch sample_on_annulus(int n, double r_lo, double r_hi, std::mt19937_64& rng);

@@ -178,6 +178,10 @@ class DataRun : public FieldModelRun {
         model, p_.units, p_.measured.held_out, p_.measured.coordinates, data_.train_x,
         {.threshold = p_.config.threshold, .truth = p_.truth.get()});
     m.update(held.metrics);
+    if (dynamics().config().field == nn::FieldType::kBoth) {
+      m["dissipation_share"] = number(dissipation_share(
+          dynamics(), data_.test_x, [&](const Batch& f) { return p_.units.rate_to_file(f); }));
+    }
     m.update(energy_metrics(file));
     m["units"] = p_.units.to_json();
     m["state_names"] = p_.measured.state_names;
@@ -220,11 +224,14 @@ class DataRun : public FieldModelRun {
   // and the last gives H in the file's units (an HNN) or dx/dt (a baseline). Exact: an affine map
   // into a linear layer is a linear layer.
   std::unique_ptr<nn::DynamicsModel<double>> model_in_data_units() const override {
+    HNN_TASKS_CHECK(dynamics().config().field != nn::FieldType::kBoth,
+                    "a dhnn trained on standardised data has no single D in the file's units "
+                    "(its dissipation scales per column); only an hnn or a baseline converts");
     std::unique_ptr<nn::DynamicsModel<double>> m = nn::cast_model<double>(dynamics());
     const Units& u = p_.units;
     const std::size_t layers = m->config().hidden.size() + 1;
     const Eigen::RowVectorXd output_scale =
-        m->config().model == nn::ModelKind::kHnn
+        nn::learns_scalars(m->config().model)
             ? Eigen::RowVectorXd::Constant(m->mlp().config().widths.back(), u.energy_to_file())
             : Eigen::RowVectorXd(u.scale / u.time);
     nn::Matrix<double> first_weight;

@@ -50,6 +50,7 @@ class FieldModelRun : public TaskRun {
   template <typename T>
   std::unique_ptr<nn::DynamicsModel<T>> fresh_model() const {
     nn::DynamicsConfig config{.model = s_.model, .dim = data_.train_x.cols()};
+    if (s_.model == nn::ModelKind::kDhnn) config.field = nn::FieldType::kBoth;
     config.hidden.assign(s_.train.hidden.begin(), s_.train.hidden.end());
     try {
       nn::validate(config);

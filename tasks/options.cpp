@@ -1,5 +1,8 @@
 #include "tasks/options.h"
 
+#include <fmt/ranges.h>
+
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <sstream>
@@ -68,7 +71,7 @@ std::string_view to_string(Dtype dtype) { return dtype == Dtype::kFloat ? "float
 std::string_view to_string(Preset preset) { return preset == Preset::kLean ? "lean" : "paper"; }
 std::vector<std::string> dtype_names() { return {"float", "double"}; }
 std::vector<std::string> preset_names() { return {"paper", "lean"}; }
-std::vector<std::string> model_names() { return {"hnn", "baseline"}; }
+std::vector<std::string> model_names() { return {"hnn", "baseline", "dhnn"}; }
 
 Dtype parse_dtype(std::string_view name) {
   if (name == "float") return Dtype::kFloat;
@@ -106,6 +109,13 @@ RunSettings resolve(const Task& task, const RunOptions& o) {
   HNN_TASKS_CHECK(o.task_settings.is_object(), "task settings must be a JSON object, got {}",
                   o.task_settings.dump());
   task.check_task_settings(o.task_settings);
+  const std::vector<nn::ModelKind> models = task.models();
+  if (std::find(models.begin(), models.end(), o.model) == models.end()) {
+    std::vector<std::string_view> names;
+    for (nn::ModelKind m : models) names.push_back(nn::to_string(m));
+    throw Error(fmt::format("task '{}' does not train a {} model (its models: {})", task.name(),
+                            nn::to_string(o.model), fmt::join(names, ", ")));
+  }
   RunSettings s{.task = task.name(),
                 .model = o.model,
                 .seed = o.seed,

@@ -161,6 +161,10 @@ class PixelPendulumTask : public Task {
            "recovered from the decoded frames of 200-frame latent rollouts (dopri5) from the test "
            "trials (see energy_mse_frames_floor in its metrics.json for the recovery's own error).";
   }
+  // Its latent dynamics are an HNN or a baseline (the paper's); no dissipation in the Gym scene.
+  std::vector<nn::ModelKind> models() const override {
+    return {nn::ModelKind::kHnn, nn::ModelKind::kBaseline};
+  }
   void check_task_settings(const nlohmann::json& settings) const override {
     const std::vector<std::string> known = task_setting_names();
     for (const auto& [key, value] : settings.items()) {

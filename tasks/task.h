@@ -83,6 +83,10 @@ class Task {
   virtual void write_comparison(const std::filesystem::path& baseline_run,
                                 const std::filesystem::path& hnn_run,
                                 const std::filesystem::path& out) const;
+  /// The model kinds a run of this task can train: by default hnn, baseline and dhnn.
+  virtual std::vector<nn::ModelKind> models() const {
+    return {nn::ModelKind::kHnn, nn::ModelKind::kBaseline, nn::ModelKind::kDhnn};
+  }
   /// Whether --data FILE applies (tasks on measured data).
   virtual bool reads_data_file() const { return false; }
   /// Checks the task's own settings (RunSettings::task_settings); throws Error naming an unknown
@@ -93,7 +97,8 @@ class Task {
 };
 
 /// The tasks by name: spring, pendulum, real-pendulum, two-body, three-body, pixel-pendulum (the
-/// paper's) and data (a user's own file). Throws Error naming the known tasks for any other name.
+/// paper's), damped-spring (the dissipative-HNN paper's) and data (a user's own file). Throws Error
+/// naming the known tasks for any other name.
 std::unique_ptr<Task> make_task(const std::string& name);
 std::vector<std::string> task_names();
 /// The paper's six: what `hnn reproduce` runs by default.

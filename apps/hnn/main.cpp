@@ -66,10 +66,12 @@ void train_until_done_or_stopped(tasks::RunOptions o) {
 // `hnn train --resume DIR`: the settings are the checkpoint's; only options that cannot change
 // the result may be given again.
 tasks::RunOptions resumed_options(const CLI::App& cmd, const std::string& dir, bool quiet) {
-  for (const char* name : {"task", "--model", "--steps", "--seed", "--dtype", "--preset", "--batch",
-                           "--hidden", "--lr", "--data", "--settings", "--out", "--coords", "--momenta",
-                           "--velocities", "--derivatives", "--time", "--trajectory", "--split",
-                           "--test-fraction", "--hamiltonian"}) {
+  for (const char* name :
+       {"task",          "--model", "--steps",      "--seed",    "--dtype",
+        "--preset",      "--batch", "--hidden",     "--lr",      "--data",
+        "--settings",    "--out",   "--coords",     "--momenta", "--velocities",
+        "--derivatives", "--time",  "--trajectory", "--split",   "--test-fraction",
+        "--hamiltonian"}) {
     if (cmd.get_option(name)->count() > 0) {
       throw std::invalid_argument(fmt::format(
           "{} cannot be combined with --resume: a resumed run keeps its own settings", name));
@@ -108,7 +110,8 @@ void add_train_command(CLI::App& app) {
   auto resume = std::make_shared<std::string>();
   auto checkpoint_every = std::make_shared<long>(0);
   cmd->add_option("task", options->task, "Task: " + task_list() + " (required unless --resume)");
-  cmd->add_option("--model", *model, "hnn or baseline")
+  cmd->add_option("--model", *model,
+                  "hnn, baseline or dhnn (the dissipative HNN: H and a dissipation potential D)")
       ->check(CLI::IsMember(tasks::model_names()))
       ->capture_default_str();
   cmd->add_option("--steps", *steps, "Training steps (default: the paper's)")

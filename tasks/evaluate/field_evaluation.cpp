@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "autodiff/tape.h"
 #include "nn/hnn.h"
 #include "tasks/report/csv_cell.h"
 #include "tasks/report/json_values.h"
@@ -20,6 +21,22 @@ double r_squared(double mse, const Batch& dxdt) {
   return variance > 0 ? 1 - mse / variance : NAN;
 }
 
+double dissipation_share(const nn::DynamicsModel<double>& model, const Batch& x,
+                         const std::function<Batch(const Batch&)>& to_data_units) {
+  const auto* hnn = dynamic_cast<const nn::Hnn<double>*>(&model);
+  if (hnn == nullptr || model.config().field != nn::FieldType::kBoth || x.rows() == 0) return NAN;
+  ad::TapeScope scope;
+  ad::NoGradGuard values_only;
+  const auto parts = hnn->time_derivative_parts(ad::Var<double>::leaf(x));
+  Batch solenoidal = parts.solenoidal.value(), conservative = parts.conservative.value();
+  if (to_data_units) {
+    solenoidal = to_data_units(solenoidal);
+    conservative = to_data_units(conservative);
+  }
+  const double d = conservative.squaredNorm();
+  return d / (solenoidal.squaredNorm() + d);
+}
+
 FieldEvaluation evaluate_field_model(const physics::System& truth,
                                      const nn::DynamicsModel<double>& model, const Dataset& data,
                                      const Batch& x0, const RolloutConfig& config) {
@@ -33,6 +50,9 @@ FieldEvaluation evaluate_field_model(const physics::System& truth,
                {"energy_mse", number(energy.mean)}, {"energy_mse_se", number(energy.std_error)},
                {"n_rollouts", energy.count},        {"rollout_failures", e.rollouts.failures},
                {"n_train", data.train_x.rows()},    {"n_test", data.test_x.rows()}};
+  e.metrics["state_mse"] = number(state_mse(e.rollouts));
+  if (model.config().field == nn::FieldType::kBoth)
+    e.metrics["dissipation_share"] = number(dissipation_share(model, data.test_x));
   e.metrics["train_r2"] = number(r_squared(train.mean, data.train_dxdt));
   e.metrics["test_r2"] = number(r_squared(test.mean, data.test_dxdt));
   e.metrics["eval_seconds"] =

@@ -2,6 +2,7 @@
 // The evaluation of the tasks that learn a field: losses over both splits with standard errors,
 // and the energy MSE of rollouts against the true system, as the metrics of metrics.json.
 
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <string>
 
@@ -22,6 +23,12 @@ struct FieldEvaluation {
 /// 1 - MSE / variance of the targets (over all components): the share of the targets' spread a
 /// model explains, whatever the data's units. NaN for no targets or constant ones.
 double r_squared(double mse, const Batch& dxdt);
+
+/// For a model with a Hamiltonian and a dissipative part (a dhnn), the share of its field's
+/// squared norm over the states x that is dissipation: sum |dD/dx|^2 / (sum |(dH/dp, -dH/dq)|^2
+/// + sum |dD/dx|^2), each part first carried by `to_data_units` when given. NaN otherwise.
+double dissipation_share(const nn::DynamicsModel<double>& model, const Batch& x,
+                         const std::function<Batch(const Batch&)>& to_data_units = {});
 
 /// Evaluates `model` on `data` and on rollouts from `x0` against `truth`.
 FieldEvaluation evaluate_field_model(const physics::System& truth,

@@ -78,7 +78,7 @@ HeldOutEvaluation evaluate_held_out(const LearnedField& model, const Units& unit
                                     const Batch& train_z, const HeldOutOptions& options) {
   HeldOutEvaluation e;
   std::vector<double> mse, valid, drift, drift_relative;
-  double sum = 0, count = 0;
+  double sum = 0, count = 0, energy_sum = 0, energy_count = 0;
   int censored = 0;
   std::vector<std::string> failures;
   double h_spread = NAN;
@@ -107,6 +107,10 @@ HeldOutEvaluation evaluate_held_out(const LearnedField& model, const Units& unit
       count += double(sq.size());
       valid.push_back(r.valid_time);
       censored += r.censored ? 1 : 0;
+      if (r.pred_energy.size() > 0) {
+        energy_sum += (r.pred_energy - r.true_energy).squaredNorm();
+        energy_count += double(r.pred_energy.size());
+      }
       if (r.learned_h.size() > 0) {
         const double d = (r.learned_h.array() - r.learned_h(0)).abs().maxCoeff();
         drift.push_back(d);
@@ -122,6 +126,9 @@ HeldOutEvaluation evaluate_held_out(const LearnedField& model, const Units& unit
                {"n_held_out", held_out.size()},
                {"held_out_failures", failures}};
   e.metrics.update(summary_json("valid_prediction_time", valid));
+  if (options.truth != nullptr) {
+    e.metrics["held_out_energy_mse"] = number(energy_count > 0 ? energy_sum / energy_count : NAN);
+  }
   if (model.hamiltonian) {
     e.metrics.update(summary_json("learned_h_drift", drift));
     e.metrics.update(summary_json("learned_h_drift_relative", drift_relative));

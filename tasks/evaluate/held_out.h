@@ -39,7 +39,9 @@ struct HeldOutEvaluation {
   /// coordinate_mse (file units, over every time and coordinate), valid_prediction_time (file
   /// time, mean over stretches), learned_h_drift (max |H(t) - H(0)| per stretch, mean, file
   /// units) and learned_h_drift_relative (that over the spread of H on the training states),
-  /// each with a standard error over stretches when there are several.
+  /// each with a standard error over stretches when there are several; with a known H,
+  /// held_out_energy_mse: (H(measured) - H(predicted))^2 over every held-out point (the
+  /// dissipative-HNN paper's energy MSE along the test trajectory).
   nlohmann::json metrics;
 };
 

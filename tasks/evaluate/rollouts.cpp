@@ -126,6 +126,16 @@ nn::MeanStderr energy_mse(const Rollouts& r) {
   return out;
 }
 
+double state_mse(const Rollouts& r) {
+  double sum = 0, count = 0;
+  for (std::size_t i = 0; i < r.truth.size(); ++i) {
+    if (r.failed[i]) continue;
+    sum += (r.truth[i] - r.pred[i]).squaredNorm();
+    count += double(r.truth[i].size());
+  }
+  return count > 0 ? sum / count : NAN;
+}
+
 Eigen::VectorXd coordinate_mse_over_time(const Rollouts& r) {
   const Eigen::Index m = Eigen::Index(r.t.size());
   Eigen::VectorXd mse = Eigen::VectorXd::Zero(m);

@@ -65,6 +65,10 @@ Rollouts make_rollouts(const physics::System& truth, const LearnedField& learned
 /// from 5 interleaved splits of the trajectories (the reference's "bootstrap" of 5 splits).
 nn::MeanStderr energy_mse(const Rollouts& rollouts);
 
+/// Mean over the learned rollouts that did not fail, their times and every state component of
+/// the squared state error (the dissipative-HNN paper's state MSE); NaN when all failed.
+double state_mse(const Rollouts& rollouts);
+
 /// Mean over trajectories of the coordinate MSE at each time (for the charts).
 Eigen::VectorXd coordinate_mse_over_time(const Rollouts& rollouts);
 
