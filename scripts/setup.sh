@@ -6,8 +6,8 @@ packages=(
   build-essential cmake pkg-config
   libeigen3-dev libfmt-dev libcli11-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  libgif-dev libpng-dev libopenblas-pthread-dev libxtensor-dev libzip-dev libginac-dev
-  python3-matplotlib python3-numpy
+  libgif-dev libpng-dev libopenblas-pthread-dev libxtensor-dev libzip-dev libginac-dev libyaml-cpp-dev
+  python3-matplotlib python3-numpy python3-distributed
 )
 
 missing=()

@@ -24,5 +24,7 @@ void add_analysis_commands(CLI::App& app);
 void add_simulate_command(CLI::App& app);
 /// export: a trained HNN's H as C source or JSON (apps/hnn/export_command.cpp).
 void add_export_command(CLI::App& app);
+/// sweep: a grid of runs from a spec file, through Dask (apps/hnn/sweep_command.cpp).
+void add_sweep_command(CLI::App& app);
 
 }  // namespace hnn::app

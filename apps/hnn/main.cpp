@@ -235,6 +235,7 @@ int main(int argc, char** argv) {
   hnn::app::add_analysis_commands(app);
   hnn::app::add_simulate_command(app);
   hnn::app::add_export_command(app);
+  hnn::app::add_sweep_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::RuntimeError& e) {
