@@ -236,8 +236,9 @@ def run_sweep(plan):
                     progress.done += 1
                     if not result.get("skipped"):
                         progress.durations.append(result["seconds"])
-                    progress.line(f"{name}: {result.get('seconds', 0):.1f} s on "
-                                  f"{result.get('worker')}")
+                    progress.line(f"{name}: " + ("finished before" if result.get("skipped") else
+                                  f"{result['seconds']:.1f} s on {result['worker']}"
+                                  + (", resumed" if result["resumed"] else "")))
                 else:
                     progress.failed += 1
                     failures.append((name, result["reason"]))

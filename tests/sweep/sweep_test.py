@@ -1,0 +1,398 @@
+#!/usr/bin/python3
+"""Tests of `hnn sweep` (issue 19), run by ctest as sweep.<Case> with HNN_EXE (the hnn program)
+and HNN_SOURCE_DIR in the environment:  /usr/bin/python3 tests/sweep/sweep_test.py -v Cluster
+
+Cluster starts a real `dask scheduler` and two `dask worker`s on 127.0.0.1, kills one of them in
+the middle of a run, and checks that every run finishes once with the metrics of the same runs
+trained one at a time by `hnn train`. The others: bad specs, the lock, --emit slurm, a run's own
+failure on a local cluster, and the shipped specs against the runs they replace."""
+
+import fcntl
+import json
+import os
+import re
+import shlex
+import shutil
+import signal
+import socket
+import subprocess
+import sys
+import tempfile
+import time
+import unittest
+
+HNN = os.environ.get("HNN_EXE", "build/apps/hnn")
+SOURCE = os.environ.get("HNN_SOURCE_DIR", os.getcwd())
+TIMINGS = ("train_seconds", "eval_seconds", "data_seconds")  # reliability_util.h without_timings
+
+
+def hnn(*args, **kwargs):
+    return subprocess.run([HNN, *args], capture_output=True, text=True, timeout=600, **kwargs)
+
+
+def without_timings(metrics):
+    return {k: v for k, v in metrics.items() if k not in TIMINGS}
+
+
+def read_json(path):
+    with open(path) as f:
+        return json.load(f)
+
+
+def events(out):
+    path = os.path.join(out, "events.jsonl")
+    if not os.path.exists(path):
+        return []
+    with open(path) as f:
+        return [json.loads(line) for line in f if line.strip()]
+
+
+def read_text(path):
+    with open(path) as f:
+        return f.read()
+
+
+def write(path, text):
+    with open(path, "w") as f:
+        f.write(text)
+    return path
+
+
+class SweepCase(unittest.TestCase):
+    def setUp(self):
+        self.dir = tempfile.mkdtemp(prefix="hnn-sweep-test-")
+
+    def tearDown(self):
+        shutil.rmtree(self.dir, ignore_errors=True)
+
+    def path(self, *parts):
+        return os.path.join(self.dir, *parts)
+
+    def assert_one_line_error(self, result, *needles):
+        self.assertEqual(result.returncode, 1, result.stderr)
+        lines = result.stderr.splitlines()
+        self.assertEqual(len(lines), 1, result.stderr)
+        self.assertTrue(lines[0].startswith("hnn: error: "), lines[0])
+        for needle in needles:
+            self.assertIn(needle, lines[0])
+
+
+class SpecErrors(SweepCase):
+    """Every bad spec: one line naming the key, exit 1, before anything runs or is written."""
+
+    CASES = [
+        ('{"task": ["sprin"]}', "json", "key 'task': unknown task 'sprin'"),
+        ('{"task": ["spring"], "stepz": [10]}', "json", "key 'stepz': not an option of hnn train"),
+        ('{"task": ["spring"], "seed": []}', "json", "key 'seed': an empty list"),
+        ('{"task": ["spring"], "steps": ["200"]}', "json", "key 'steps': expected an integer"),
+        ('{"task": ["spring"], "steps": 200}', "json", "key 'steps': expected a list of values"),
+        ('{"task": ["spring"], "lr": [0]}', "json", "key 'lr': expected a finite number > 0"),
+        ('{"task": ["spring"], "hidden": [16, 16]}', "json", "key 'hidden': the value 16 is listed"),
+        ('{"task": ["spring"], "hidden": [["a"]]}', "json", "key 'hidden': expected hidden widths"),
+        ('{"task": ["spring"], "model": ["mlp"]}', "json", "key 'model': unknown model 'mlp'"),
+        ('{"task": ["spring"], "dtype": [32]}', "json", "key 'dtype': expected a dtype"),
+        ('{"task": ["spring"], "threads": [4]}', "json", "key 'threads': set by hnn sweep"),
+        ('{"task": ["spring"], "coords": ["q"]}', "json", "key 'coords': applies to the data task"),
+        ('{"model": ["hnn"]}', "json", "key 'task': missing"),
+        ('{}', "json", "no keys"),
+        ('{"grids": []}', "json", "key 'grids': expected a non-empty list"),
+        ('{"task": ["spring"], "grids": [{"task": ["pendulum"]}]}', "json",
+         "key 'task': given both beside \"grids\" and in grid 1"),
+        ('{"task": ["spring"], "charts": [{"x": "seed", "y": "test_loss"}]}', "json",
+         "key 'charts': chart 1: 'x' must be one of the spec's keys"),
+        ('{"task": ["spring"],', "json", "not valid JSON"),
+        ("task: [spring]\nseed: [0, x]\n", "yaml", "key 'seed': expected an integer"),
+        ("task: [spring]\n  seed: [0\n", "yaml", "not valid YAML"),
+        ('{"task": ["spring"], "settings": [{"trials": 3}]}', "json",
+         "run 'spring/hnn/settings=trials-3': task 'spring' has no settings"),
+    ]
+
+    def test_each_bad_spec_is_one_line_naming_its_key(self):
+        for i, (text, ext, needle) in enumerate(self.CASES):
+            with self.subTest(spec=text):
+                spec = write(self.path(f"bad{i}.{ext}"), text)
+                out = self.path(f"out{i}")
+                result = hnn("sweep", spec, "--out", out)
+                self.assert_one_line_error(result, f"sweep spec {spec}: ", needle)
+                self.assertFalse(os.path.exists(out), "a bad spec must write nothing")
+
+    def test_bad_options(self):
+        spec = write(self.path("ok.json"), '{"task": ["spring"]}')
+        self.assert_one_line_error(hnn("sweep", spec, "--out", self.path("o"), "--emit", "pbs"),
+                                   "--emit")
+        self.assert_one_line_error(
+            hnn("sweep", spec, "--out", self.path("o"), "--scheduler", "localhost"),
+            "--scheduler expects a Dask scheduler's address")
+
+
+class Lock(SweepCase):
+    def test_a_second_sweep_on_a_locked_folder_is_refused(self):
+        spec = write(self.path("s.json"), '{"task": ["spring"], "steps": [5]}')
+        out = self.path("out")
+        os.makedirs(out)
+        with open(os.path.join(out, "sweep.lock"), "w") as lock:
+            lock.write("pid 4242 on host elsewhere since 2024-01-01T00:00:00Z\n")
+            lock.flush()
+            fcntl.flock(lock, fcntl.LOCK_EX)
+            result = hnn("sweep", spec, "--out", out)
+            self.assert_one_line_error(result, f"sweep folder '{out}' is in use by another sweep",
+                                       "pid 4242 on host elsewhere")
+            self.assertFalse(os.path.exists(os.path.join(out, "plan.json")))
+            self.assertFalse(os.path.exists(os.path.join(out, "runs")))
+        # Released (the holder exited): the folder is free again, whatever the file says.
+        result = hnn("sweep", spec, "--out", out, "--emit", "slurm")
+        self.assertEqual(result.returncode, 0, result.stderr)
+        self.assertRegex(read_text(os.path.join(out, "sweep.lock")),
+                         rf"^pid \d+ on host {re.escape(socket.gethostname())} since ")
+
+
+class Slurm(SweepCase):
+    def test_emit_slurm_writes_a_job_array_of_the_runs(self):
+        spec = write(self.path("s.json"), json.dumps(
+            {"task": ["spring"], "model": ["hnn", "baseline"], "seed": [0, 1],
+             "hidden": [[8]], "steps": [20], "settings": [{}]}))
+        out = self.path("out")
+        result = hnn("sweep", spec, "--out", out, "--emit", "slurm", "--threads-per-run", "2")
+        self.assertEqual(result.returncode, 0, result.stderr)
+        script = os.path.join(out, "sweep.slurm")
+        text = read_text(script)
+        self.assertTrue(text.startswith("#!/bin/bash\n"))
+        for line in ("#SBATCH --array=0-3", "#SBATCH --cpus-per-task=2",
+                     f"#SBATCH --output={out}/slurm/%A_%a.log", f"hnn={out}/hnn",
+                     f"hnn sweep {spec} --out {out} --collect"):
+            self.assertIn(line, text)
+        self.assertTrue(os.path.isdir(os.path.join(out, "slurm")))
+        plan = read_json(os.path.join(out, "plan.json"))
+        listed = hnn("sweep", spec, "--out", out, "--list").stdout.splitlines()
+        for i, run in enumerate(plan["runs"]):
+            arm = f"  {i}) train {shlex.quote(os.path.join(out, 'runs', run['name']))} " \
+                  f"{' '.join(shlex.quote(a) for a in run['args'])} ;;"
+            self.assertIn(arm, text)
+            self.assertIn(" ".join(shlex.quote(a) for a in run["args"]), listed[i])
+        self.assertEqual(subprocess.run(["bash", "-n", script]).returncode, 0)
+
+        # One array task, run here as Slurm would: trains its run; again, finds it finished.
+        env = dict(os.environ, SLURM_ARRAY_TASK_ID="1", SLURM_CPUS_PER_TASK="1")
+        first = subprocess.run(["bash", script], env=env, capture_output=True, text=True)
+        self.assertEqual(first.returncode, 0, first.stderr)
+        run1 = os.path.join(out, "runs", plan["runs"][1]["name"])
+        self.assertEqual(read_json(os.path.join(run1, "metrics.json"))["seed"], 1)
+        again = subprocess.run(["bash", script], env=env, capture_output=True, text=True)
+        self.assertIn("is finished", again.stdout)
+        beyond = subprocess.run(["bash", script], capture_output=True, text=True,
+                                env=dict(os.environ, SLURM_ARRAY_TASK_ID="4"))
+        self.assertEqual(beyond.returncode, 1)
+
+        collected = hnn("sweep", spec, "--out", out, "--collect")
+        self.assertEqual(collected.returncode, 0, collected.stderr)
+        table = read_json(os.path.join(out, "results.json"))
+        self.assertEqual(table["counts"], {"done": 1, "failed": 0, "pending": 3})
+        self.assertEqual(table["runs"][1]["status"], "done")
+
+
+class LocalCluster(SweepCase):
+    def test_a_failing_run_is_reported_in_one_line_and_the_rest_finish(self):
+        bad_data = write(self.path("bad.txt"), "not a measured pendulum\n")
+        spec = write(self.path("s.yaml"), f"""
+grids:
+  - {{task: [spring], seed: [0, 1], hidden: [[8]], steps: [50]}}
+  - {{task: [real-pendulum], data: ["{bad_data}"], steps: [50]}}
+charts:
+  - {{x: seed, y: test_loss}}
+""")
+        out = self.path("out")
+        result = hnn("sweep", spec, "--out", out, "--workers", "2")
+        self.assertEqual(result.returncode, 1, result.stderr)
+        self.assertEqual(result.stderr.splitlines()[-1],
+                         "hnn: error: sweep: 1 of 3 runs failed (their reasons above and in "
+                         "results.csv)")
+        table = read_json(os.path.join(out, "results.json"))
+        self.assertEqual(table["counts"], {"done": 2, "failed": 1, "pending": 0})
+        failed = table["runs"][2]
+        direct = hnn("train", "real-pendulum", "--data", bad_data, "--steps", "50", "--quiet",
+                     "--out", self.path("direct"))
+        self.assertEqual(direct.returncode, 1)
+        self.assertEqual("hnn: error: " + failed["reason"], direct.stderr.strip())
+        self.assertIn(f"failed: {failed['run']}: {failed['reason']}", result.stdout)
+        self.assertTrue(os.path.exists(os.path.join(out, "chart-1.png")))
+        self.assertTrue(read_text(os.path.join(out, "results.csv")).startswith("run,status,reason,"))
+
+        # Again: nothing runs (the failure is reported, not retried), still exit 1.
+        before = events(out)
+        again = hnn("sweep", spec, "--out", out)
+        self.assertEqual(again.returncode, 1)
+        self.assertIn("all 3 runs are finished (1 failed): nothing to run", again.stdout)
+        self.assertEqual(events(out), before)
+
+
+def free_port():
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+class Cluster(SweepCase):
+    """A real scheduler and two workers; one is killed while it trains a run."""
+
+    def start(self, *args):
+        with open(self.path(f"{args[0]}-{len(self.procs)}.log"), "w") as log:
+            proc = subprocess.Popen(["dask", *args], cwd=self.dir, stdout=subprocess.DEVNULL,
+                                    stderr=log, start_new_session=True)
+        self.procs.append(proc)
+        return proc
+
+    def setUp(self):
+        super().setUp()
+        self.procs = []
+        port = free_port()
+        self.address = f"tcp://127.0.0.1:{port}"
+        self.start("scheduler", "--host", "127.0.0.1", "--port", str(port), "--no-dashboard")
+        self.workers = {name: self.start("worker", self.address, "--name", name, "--nthreads",
+                                         "1", "--no-nanny", "--local-directory", self.path(name))
+                        for name in ("w1", "w2")}
+        from distributed import Client
+        with Client(self.address, timeout="30s") as client:
+            client.wait_for_workers(2, timeout=60)
+
+    def tearDown(self):
+        for proc in reversed(self.procs):
+            if proc.poll() is None:
+                os.killpg(proc.pid, signal.SIGTERM)
+                try:
+                    proc.wait(timeout=10)
+                except subprocess.TimeoutExpired:
+                    os.killpg(proc.pid, signal.SIGKILL)
+                    proc.wait()
+        super().tearDown()
+
+    def steps_for(self, seconds):
+        """Training steps of a run of about `seconds` on this machine (sanitized builds are
+        slower): measured on one short run."""
+        hnn("train", "spring", "--hidden", "32", "32", "--steps", "300", "--threads", "1",
+            "--quiet", "--out", self.path("calibrate"))
+        per_step = read_json(self.path("calibrate", "metrics.json"))["train_seconds"] / 300
+        return max(600, min(20000, int(seconds / per_step) // 100 * 100))
+
+    def kill_mid_run(self, out, name):
+        """SIGKILLs worker `name` once it trains a run that has checkpointed; returns that run."""
+        deadline = time.time() + 120
+        while time.time() < deadline:
+            for e in events(out):
+                if e["worker"] == name and e["event"] in ("start", "resume"):
+                    state = os.path.join(out, "runs", e["run"], "checkpoint", "state.json")
+                    done = any(d["run"] == e["run"] and d["event"] == "done" for d in events(out))
+                    if os.path.exists(state) and not done:
+                        os.kill(self.workers[name].pid, signal.SIGKILL)
+                        return e["run"]
+            time.sleep(0.02)
+        self.fail(f"worker {name} never trained a run")
+
+    def test_a_killed_worker_s_run_resumes_elsewhere_and_every_run_finishes_once(self):
+        steps = self.steps_for(1.5)
+        seeds = list(range(6))
+        spec = write(self.path("s.json"), json.dumps(
+            {"task": ["spring"], "model": ["hnn", "baseline"], "seed": seeds,
+             "hidden": [[32, 32]], "steps": [steps], "checkpoint-every": [steps // 10]}))
+        out = self.path("out")
+        sweep = subprocess.Popen([HNN, "sweep", spec, "--out", out, "--scheduler", self.address],
+                                 stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        killed = self.kill_mid_run(out, "w1")
+        stdout, stderr = sweep.communicate(timeout=600)
+        print(f"\n{stdout}killed worker w1 while it trained {killed} ({steps} steps)",
+              file=sys.stderr)
+        self.assertEqual(sweep.returncode, 0, stderr)
+        self.assertIn("12/12 done, 0 running, 0 failed", stdout)
+
+        log = events(out)
+        runs = read_json(os.path.join(out, "plan.json"))["runs"]
+        self.assertEqual(len(runs), 12)
+        for run in runs:
+            done = [e for e in log if e["run"] == run["name"] and e["event"] == "done"]
+            self.assertEqual(len(done), 1, f"{run['name']} finished {len(done)} times")
+        resumed = [e for e in log if e["run"] == killed and e["event"] == "resume"]
+        self.assertEqual([e["worker"] for e in resumed], ["w2"], log)
+        self.assertTrue(read_json(os.path.join(out, "runs", killed, "sweep.json"))["resumed"])
+
+        # The same runs, one at a time.
+        table = read_json(os.path.join(out, "results.json"))
+        self.assertEqual(table["counts"], {"done": 12, "failed": 0, "pending": 0})
+        for row in table["runs"]:
+            v = row["values"]
+            ref = self.path("ref", row["run"])
+            direct = hnn("train", "spring", "--model", v["model"], "--seed", str(v["seed"]),
+                         "--hidden", "32", "32", "--steps", str(steps), "--threads", "1",
+                         "--quiet", "--out", ref)
+            self.assertEqual(direct.returncode, 0, direct.stderr)
+            self.assertEqual(without_timings(row["metrics"]),
+                             without_timings(read_json(os.path.join(ref, "metrics.json"))),
+                             row["run"])
+
+        # A finished sweep, run again: nothing runs.
+        start = time.time()
+        again = hnn("sweep", spec, "--out", out, "--scheduler", self.address)
+        self.assertEqual(again.returncode, 0, again.stderr)
+        self.assertIn("all 12 runs are finished (0 failed): nothing to run", again.stdout)
+        self.assertEqual(events(out), log)
+        self.assertLess(time.time() - start, 30)
+
+
+class ShippedSpecs(SweepCase):
+    """sweeps/*.{json,yaml} expand to the runs of what they replace."""
+
+    @staticmethod
+    def runs_of(lines):
+        """(task, model, dtype, hidden, seed, other options) of each `... train ...` line."""
+        runs = []
+        for line in lines:
+            words = shlex.split(line)
+            if "train" not in words or "--out" not in words:
+                continue
+            words = words[words.index("train") + 1:]
+            run = {"task": words[0], "model": "hnn", "dtype": "double", "hidden": "", "seed": "0",
+                   "other": []}
+            i = 1
+            while i < len(words):
+                option, i = words[i], i + 1
+                values = []
+                while i < len(words) and not words[i].startswith("--"):
+                    values.append(words[i])
+                    i += 1
+                key = option[2:]
+                if key in ("model", "dtype", "seed"):
+                    run[key] = values[0]
+                elif key == "hidden":
+                    run["hidden"] = "-".join(values)
+                elif key not in ("threads", "quiet", "out"):
+                    run["other"].append(option)
+            runs.append((run["task"], run["model"], run["dtype"], run["hidden"], run["seed"],
+                         tuple(run["other"])))
+        return runs
+
+    def test_model_size_is_the_runs_of_scripts_sweep_py(self):
+        tasks = "spring,pendulum,real-pendulum,two-body,three-body,pixel-pendulum"
+        old = subprocess.run([sys.executable, os.path.join(SOURCE, "scripts", "sweep.py"),
+                              "--hnn", HNN, "--out", self.path("old"), "--tasks", tasks,
+                              "--dry-run"], capture_output=True, text=True, check=True)
+        new = hnn("sweep", os.path.join(SOURCE, "sweeps", "model_size.yaml"), "--out",
+                  self.path("new"), "--list")
+        self.assertEqual(new.returncode, 0, new.stderr)
+        old_runs, new_runs = self.runs_of(old.stdout.splitlines()), self.runs_of(
+            new.stdout.splitlines())
+        self.assertEqual(len(new_runs), 124)
+        self.assertEqual(len(set(new_runs)), 124)
+        self.assertEqual(sorted(new_runs), sorted(old_runs))
+
+    def test_table1_is_the_runs_of_hnn_reproduce(self):
+        # reproduce's own list of its tasks, from its refusal of another.
+        refusal = hnn("reproduce", "--tasks", "data", "--out", self.path("r")).stderr
+        paper = re.search(r"runs the paper's tasks \(([^)]*)\)", refusal).group(1).split(", ")
+        new = hnn("sweep", os.path.join(SOURCE, "sweeps", "table1.json"), "--out",
+                  self.path("new"), "--list")
+        self.assertEqual(new.returncode, 0, new.stderr)
+        expected = [(task, model, "double", "", "0", ()) for task in paper
+                    for model in ("baseline", "hnn")]
+        self.assertEqual(self.runs_of(new.stdout.splitlines()), expected)
+
+
+if __name__ == "__main__":
+    unittest.main()
