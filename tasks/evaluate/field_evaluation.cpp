@@ -51,6 +51,10 @@ FieldEvaluation evaluate_field_model(const physics::System& truth,
                {"n_rollouts", energy.count},        {"rollout_failures", e.rollouts.failures},
                {"n_train", data.train_x.rows()},    {"n_test", data.test_x.rows()}};
   e.metrics["state_mse"] = number(state_mse(e.rollouts));
+  const RelativeError relative = relative_error(e.rollouts);
+  e.metrics["relative_error_geomean"] = number(relative.geomean);
+  e.metrics["valid_prediction_time"] = number(relative.valid_time);
+  e.metrics["valid_prediction_censored"] = relative.censored;
   if (model.config().field == nn::FieldType::kBoth)
     e.metrics["dissipation_share"] = number(dissipation_share(model, data.test_x));
   e.metrics["train_r2"] = number(r_squared(train.mean, data.train_dxdt));

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -134,6 +135,34 @@ double state_mse(const Rollouts& r) {
     count += double(r.truth[i].size());
   }
   return count > 0 ? sum / count : NAN;
+}
+
+RelativeError relative_error(const Rollouts& r, double threshold) {
+  RelativeError out;
+  double log_sum = 0, valid_sum = 0;
+  long count = 0, used = 0;
+  for (std::size_t i = 0; i < r.truth.size(); ++i) {
+    if (r.failed[i]) continue;
+    const Eigen::MatrixXd& x = r.truth[i];
+    const Eigen::MatrixXd& y = r.pred[i];
+    double valid = r.t.back() - r.t.front();
+    bool passed = false;
+    for (Eigen::Index k = 1; k < x.rows(); ++k) {
+      const double e = (y.row(k) - x.row(k)).norm() / (y.row(k).norm() + x.row(k).norm());
+      log_sum += std::log(std::max(e, 1e-300));
+      ++count;
+      if (!passed && !(e <= threshold)) {
+        valid = r.t[std::size_t(k)] - r.t.front();
+        passed = true;
+      }
+    }
+    valid_sum += valid;
+    out.censored += passed ? 0 : 1;
+    ++used;
+  }
+  if (count > 0) out.geomean = std::exp(log_sum / double(count));
+  if (used > 0) out.valid_time = valid_sum / double(used);
+  return out;
 }
 
 Eigen::VectorXd coordinate_mse_over_time(const Rollouts& r) {

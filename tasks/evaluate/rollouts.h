@@ -69,6 +69,16 @@ nn::MeanStderr energy_mse(const Rollouts& rollouts);
 /// the squared state error (the dissipative-HNN paper's state MSE); NaN when all failed.
 double state_mse(const Rollouts& rollouts);
 
+/// The relative state error e(t) = |x^ - x| / (|x^| + |x|) of the learned rollouts against the
+/// true ones (Finzi et al. 2020): its geometric mean over every trajectory and time after the
+/// start, and the valid prediction time, the first time e passes `threshold` (mean over the
+/// trajectories; a trajectory that never passes it counts its whole span and is `censored`).
+struct RelativeError {
+  double geomean = NAN, valid_time = NAN;
+  int censored = 0;
+};
+RelativeError relative_error(const Rollouts& rollouts, double threshold = 0.1);
+
 /// Mean over trajectories of the coordinate MSE at each time (for the charts).
 Eigen::VectorXd coordinate_mse_over_time(const Rollouts& rollouts);
 

@@ -339,5 +339,26 @@ TEST(FieldEvaluation, RSquaredIsOneMinusMseOverTheTargetsVariance) {
               exact["test_r2"].get<double>(), 1e-12);
 }
 
+// Finzi et al.'s relative state error: |x^ - x| / (|x^| + |x|) after the start; a prediction
+// that drifts linearly away passes 0.1 where expected, an exact one never does.
+TEST(RelativeError, GivesTheGeometricMeanAndTheValidPredictionTime) {
+  Rollouts r;
+  r.t = {0, 1, 2, 3, 4};
+  Eigen::MatrixXd x = Eigen::MatrixXd::Ones(5, 2), drift = x;
+  for (int k = 0; k < 5; ++k) drift.row(k) *= 1 + 0.15 * k;  // e = 0.15k / (2 + 0.15k)
+  r.truth = {x, x};
+  r.pred = {x * (1 + 1e-6), drift};
+  r.failed = {false, false};
+  const RelativeError e = relative_error(r);
+  // Trajectory 0: e = 5e-7 throughout, censored at 4; trajectory 1 passes 0.1 at t = 2.
+  EXPECT_DOUBLE_EQ(e.valid_time, (4.0 + 2.0) / 2);
+  EXPECT_EQ(e.censored, 1);
+  double log_sum = 4 * std::log(1e-6 / (2 + 1e-6));
+  for (int k = 1; k < 5; ++k) log_sum += std::log(0.15 * k / (2 + 0.15 * k));
+  EXPECT_NEAR(e.geomean, std::exp(log_sum / 8), 1e-9 * e.geomean);
+  r.failed = {true, true};
+  EXPECT_TRUE(std::isnan(relative_error(r).geomean));
+}
+
 }  // namespace
 }  // namespace hnn::tasks
