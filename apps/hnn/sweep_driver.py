@@ -14,10 +14,12 @@ not stop the sweep. Each run appends its events to OUT/events.jsonl.
 """
 
 import json
+import logging
 import os
 import signal
 import sys
 import time
+import warnings
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import sweep_report  # noqa: E402  (beside this file, in the source tree and in share/hnn)
@@ -129,10 +131,18 @@ def check_folders_hold_their_runs(plan):
                      f"the spec's {json.dumps(want)}): delete it, or give another --out")
 
 
+def work_estimate(settings):
+    """A run's work, roughly: steps x the hidden layers' weights. Dask starts the larger runs
+    first (its priority), so that a long run does not start last and leave the other workers
+    idle at the end."""
+    widths = [int(w) for w in str(settings.get("hidden", "1")).split("-")]
+    weights = sum(a * b for a, b in zip(widths, widths[1:])) + 10 * sum(widths)
+    return int(settings.get("steps", 1)) * weights
+
+
 def start_client(plan):
     """A Dask client: of the --scheduler's cluster, or of a new LocalCluster."""
     try:
-        import logging
         from distributed import Client, LocalCluster
     except ImportError:
         fail("Dask distributed is not installed (Debian: apt-get install python3-distributed; "
@@ -213,7 +223,8 @@ def run_sweep(plan):
     futures = {}
     for r in todo:
         f = client.submit(run_one, plan["hnn"], out, r["name"], r["args"], threads,
-                          key=f"hnn-train-{r['name']}", pure=False, retries=2)
+                          key=f"hnn-train-{r['name']}", pure=False, retries=2,
+                          priority=work_estimate(r["settings"]))
         futures[f] = r["name"]
     progress = Progress(client, len(runs), done_before, failed_before)
     failures = []
@@ -298,6 +309,8 @@ def main():
     with open(sys.argv[2]) as f:
         plan = json.load(f)
     signal.signal(signal.SIGTERM, signal.default_int_handler)  # stop as Ctrl-C does
+    warnings.filterwarnings("ignore", category=DeprecationWarning)  # Tornado's, through Dask
+    logging.getLogger("distributed").setLevel(logging.ERROR)  # e.g. a lost worker: Dask retries
     if sys.argv[1] == "emit-slurm":
         path = sweep_report.write_slurm(plan)
         say(f"{path}: a Slurm job array of {len(plan['runs'])} runs; submit it with "

@@ -225,6 +225,25 @@ charts:
         self.assertEqual(events(out), before)
 
 
+    def test_a_folder_holding_another_run_is_refused_before_anything_runs(self):
+        spec = write(self.path("s.json"), '{"task": ["spring"], "hidden": [[8]]}')
+        out = self.path("out")
+        held = os.path.join(out, "runs", "spring", "hnn", "hidden=8")
+        trained = hnn("train", "spring", "--hidden", "8", "--steps", "5", "--quiet", "--out", held)
+        self.assertEqual(trained.returncode, 0, trained.stderr)
+        result = hnn("sweep", spec, "--out", out)
+        self.assert_one_line_error(
+            result, f"sweep: run folder '{held}' holds another run (steps 5, the spec's 2000): "
+            "delete it, or give another --out")
+        self.assertEqual(events(out), [])
+
+    def test_an_unreachable_scheduler_is_one_line(self):
+        spec = write(self.path("s.json"), '{"task": ["spring"], "steps": [5]}')
+        address = f"tcp://127.0.0.1:{free_port()}"
+        result = hnn("sweep", spec, "--out", self.path("out"), "--scheduler", address)
+        self.assert_one_line_error(result, f"sweep: cannot reach the Dask scheduler {address}: ")
+
+
 def free_port():
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
