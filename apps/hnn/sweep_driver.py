@@ -25,6 +25,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import sweep_report  # noqa: E402  (beside this file, in the source tree and in share/hnn)
 
 STATUS_EVERY = 30.0  # seconds between status lines when no run ends
+STATUS_GAP = 2.0  # at least this many seconds between status lines as runs end
 
 
 # ---- one run, on a worker -------------------------------------------------------------------
@@ -193,8 +194,9 @@ class Progress:
     def line(self, note=""):
         running, slots = self.running()
         remaining = self.total - self.done - self.failed
-        say(f"{self.done}/{self.total} done, {running} running, {self.failed} failed, "
-            f"{time_left(self.durations, remaining, slots)}" + (f"  ({note})" if note else ""))
+        left = f", {time_left(self.durations, remaining, slots)}" if remaining else ""
+        say(f"{self.done}/{self.total} done, {running} running, {self.failed} failed{left}"
+            + (f"  ({note})" if note else ""))
         self.last = time.time()
 
 
@@ -221,13 +223,13 @@ def run_sweep(plan):
         + (f"dashboard {link}" if link else "no dashboard"))
     threads = plan["options"]["threads_per_run"]
     futures = {}
-    for r in todo:
+    # Largest first: the first runs go to the workers as soon as they are submitted.
+    for r in sorted(todo, key=lambda r: -work_estimate(r["settings"])):
         f = client.submit(run_one, plan["hnn"], out, r["name"], r["args"], threads,
                           key=f"hnn-train-{r['name']}", pure=False, retries=2,
                           priority=work_estimate(r["settings"]))
         futures[f] = r["name"]
     progress = Progress(client, len(runs), done_before, failed_before)
-    failures = []
     pending = as_completed(list(futures), with_results=False)
     try:
         while not pending.is_empty():
@@ -237,6 +239,7 @@ def run_sweep(plan):
                     progress.line()
                 time.sleep(0.2)
                 continue
+            note = ""
             for f in finished:
                 name = futures[f]
                 try:
@@ -247,13 +250,15 @@ def run_sweep(plan):
                     progress.done += 1
                     if not result.get("skipped"):
                         progress.durations.append(result["seconds"])
-                    progress.line(f"{name}: " + ("finished before" if result.get("skipped") else
-                                  f"{result['seconds']:.1f} s on {result['worker']}"
-                                  + (", resumed" if result["resumed"] else "")))
+                    note = f"{name}: " + ("finished before" if result.get("skipped") else
+                                          f"{result['seconds']:.1f} s on {result['worker']}"
+                                          + (", resumed" if result["resumed"] else ""))
                 else:
                     progress.failed += 1
-                    failures.append((name, result["reason"]))
-                    progress.line(f"{name} failed: {result['reason']}")
+                    progress.line(f"{name} failed: {result['reason']}")  # every failure
+            if note and time.time() - progress.last > STATUS_GAP:
+                progress.line(note)
+        progress.line()
     except KeyboardInterrupt:
         say("interrupted: the same command resumes (finished runs are kept, the others go on "
             "from their checkpoints)")
@@ -273,11 +278,12 @@ def dashboard_link(client):
         if "dashboard" not in client.scheduler_info().get("services", {}):
             return None
         status = client.dashboard_link
+        plain = status.rsplit("/", 1)[0] + "/info/main/workers.html"
         try:
-            with urllib.request.urlopen(status, timeout=2):
-                return status
+            with urllib.request.urlopen(status, timeout=2) as page:
+                return plain if b"needs bokeh" in page.read(4096) else status
         except OSError:
-            return status.rsplit("/", 1)[0] + "/info/main/workers.html"
+            return plain
     except Exception:  # noqa: BLE001  (no dashboard service)
         return None
 

@@ -17,8 +17,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "apps/hnn/sweep_keys.h"
 #include "tasks/options.h"
-#include "tasks/task.h"
 
 namespace hnn::app::sweep {
 
@@ -28,173 +28,7 @@ using nlohmann::ordered_json;
 
 namespace {
 
-enum class Kind {
-  kTask,
-  kModel,
-  kSeed,
-  kDtype,
-  kPreset,
-  kHidden,
-  kPositiveInt,
-  kNonNegativeInt,
-  kPositiveReal,
-  kFile,
-  kObject,
-  kColumns,
-  kText,
-  kSplit,
-  kFraction
-};
-
-struct KeyInfo {
-  std::string_view name;
-  Kind kind;
-  std::string_view data_setting = "";  // the data task's settings key, as `hnn train` fills it
-};
-
-// `hnn train`'s options, in the canonical order of run names and table columns.
-constexpr KeyInfo kKeys[] = {
-    {"task", Kind::kTask},
-    {"model", Kind::kModel},
-    {"seed", Kind::kSeed},
-    {"dtype", Kind::kDtype},
-    {"preset", Kind::kPreset},
-    {"hidden", Kind::kHidden},
-    {"steps", Kind::kPositiveInt},
-    {"batch", Kind::kNonNegativeInt},
-    {"lr", Kind::kPositiveReal},
-    {"data", Kind::kFile},
-    {"settings", Kind::kObject},
-    {"checkpoint-every", Kind::kPositiveInt},
-    {"coords", Kind::kColumns, "coords"},
-    {"momenta", Kind::kColumns, "momenta"},
-    {"velocities", Kind::kColumns, "velocities"},
-    {"derivatives", Kind::kColumns, "derivatives"},
-    {"time", Kind::kText, "time"},
-    {"trajectory", Kind::kText, "trajectory"},
-    {"split", Kind::kSplit, "split"},
-    {"test-fraction", Kind::kFraction, "test_fraction"},
-    {"hamiltonian", Kind::kText, "hamiltonian"},
-};
-
-// Options of `hnn train` that the sweep sets itself.
-const std::map<std::string_view, std::string_view> kSweepOwned = {
-    {"threads", "set by hnn sweep for every run (--threads-per-run)"},
-    {"out", "set by hnn sweep (OUT/runs/<run>)"},
-    {"resume", "hnn sweep resumes interrupted runs by itself"},
-    {"quiet", "hnn sweep runs quietly"}};
-
-const KeyInfo* find_key(std::string_view name) {
-  for (const KeyInfo& k : kKeys)
-    if (k.name == name) return &k;
-  return nullptr;
-}
-
 std::invalid_argument bad(std::string message) { return std::invalid_argument(message); }
-
-// ---- values --------------------------------------------------------------------------------
-
-std::string one_of(const ordered_json& v, const std::vector<std::string>& names,
-                   std::string_view what) {
-  if (v.is_string() && std::find(names.begin(), names.end(), v.get<std::string>()) != names.end())
-    return v.get<std::string>();
-  if (v.is_string())
-    throw bad(fmt::format("unknown {} '{}' (known: {})", what, v.get<std::string>(),
-                          fmt::join(names, ", ")));
-  throw bad(fmt::format("expected a {} ({}), got {}", what, fmt::join(names, ", "), v.dump()));
-}
-
-long long integer_in(const ordered_json& v, long long min, long long max) {
-  if (v.is_number_integer()) {
-    const bool fits =
-        v.is_number_unsigned()
-            ? v.get<unsigned long long>() >= static_cast<unsigned long long>(std::max(min, 0LL)) &&
-                  v.get<unsigned long long>() <= static_cast<unsigned long long>(max)
-            : v.get<long long>() >= min && v.get<long long>() <= max;
-    if (fits) return v.get<long long>();
-  }
-  if (max == std::numeric_limits<int>::max())
-    throw bad(fmt::format("expected an integer >= {}, got {}", min, v.dump()));
-  throw bad(fmt::format("expected an integer from {} to {}, got {}", min, max, v.dump()));
-}
-
-std::vector<std::string> columns(const ordered_json& v) {
-  std::vector<std::string> names;
-  if (v.is_string()) {
-    std::stringstream in(v.get<std::string>());
-    for (std::string name; std::getline(in, name, ',');) names.push_back(name);
-  } else if (v.is_array()) {
-    for (const ordered_json& name : v) {
-      if (!name.is_string()) names.clear();
-      if (!name.is_string()) break;
-      names.push_back(name.get<std::string>());
-    }
-  }
-  if (names.empty() || std::count(names.begin(), names.end(), "") > 0)
-    throw bad(
-        fmt::format("expected column names, as \"q1,q2\" or [\"q1\", \"q2\"], got {}", v.dump()));
-  return names;
-}
-
-// The value in its canonical form (hidden as a list, a file as an absolute path, ...), or
-// std::invalid_argument saying what was expected.
-ordered_json checked_value(const KeyInfo& key, const ordered_json& v) {
-  switch (key.kind) {
-    case Kind::kTask:
-      return one_of(v, tasks::task_names(), "task");
-    case Kind::kModel:
-      return one_of(v, tasks::model_names(), "model");
-    case Kind::kDtype:
-      return one_of(v, tasks::dtype_names(), "dtype");
-    case Kind::kPreset:
-      return one_of(v, tasks::preset_names(), "preset");
-    case Kind::kSplit:
-      return one_of(v, {"auto", "trajectories", "time"}, "split");
-    case Kind::kSeed:
-      if (v.is_number_unsigned()) return v;
-      throw bad(
-          fmt::format("expected an integer from 0 to 18446744073709551615, got {}", v.dump()));
-    case Kind::kPositiveInt:
-      return integer_in(v, 1, std::numeric_limits<int>::max());
-    case Kind::kNonNegativeInt:
-      return integer_in(v, 0, std::numeric_limits<int>::max());
-    case Kind::kHidden: {
-      ordered_json widths = ordered_json::array();
-      for (const ordered_json& w : v.is_array() ? v : ordered_json::array({v})) {
-        try {
-          widths.push_back(integer_in(w, 1, tasks::kMaxWidth));
-        } catch (const std::invalid_argument&) {
-          throw bad(fmt::format("expected hidden widths of 1..{}, as [200, 200] or 64, got {}",
-                                tasks::kMaxWidth, v.dump()));
-        }
-      }
-      if (widths.empty()) throw bad("expected at least one hidden width, got []");
-      return widths;
-    }
-    case Kind::kPositiveReal:
-      if (v.is_number() && std::isfinite(v.get<double>()) && v.get<double>() > 0) return v;
-      throw bad(fmt::format("expected a finite number > 0, got {}", v.dump()));
-    case Kind::kFraction:
-      if (v.is_number() && v.get<double>() > 0 && v.get<double>() < 1) return v;
-      throw bad(fmt::format("expected a number in (0, 1), got {}", v.dump()));
-    case Kind::kFile:
-      if (v.is_string() && !v.get<std::string>().empty())
-        return fs::absolute(v.get<std::string>()).lexically_normal().string();
-      throw bad(fmt::format("expected a file name, got {}", v.dump()));
-    case Kind::kObject:
-      if (v.is_object()) return v;
-      throw bad(
-          fmt::format("expected the task's settings as an object, like {{\"trials\": 20}}, "
-                      "got {}",
-                      v.dump()));
-    case Kind::kColumns:
-      return columns(v);
-    case Kind::kText:
-      if (v.is_string() && !v.get<std::string>().empty()) return v;
-      throw bad(fmt::format("expected a non-empty string, got {}", v.dump()));
-  }
-  throw bad("unhandled key");
-}
 
 // ---- grids ---------------------------------------------------------------------------------
 
@@ -203,11 +37,7 @@ struct Axis {
   std::vector<ordered_json> values;
 };
 
-std::string known_keys() {
-  std::vector<std::string_view> names;
-  for (const KeyInfo& k : kKeys) names.push_back(k.name);
-  return fmt::format("{}", fmt::join(names, ", "));
-}
+std::string known_keys() { return fmt::format("{}", fmt::join(spec_keys(), ", ")); }
 
 // One grid's keys, checked, in the file's order (the first key varies slowest).
 std::vector<Axis> axes_of(const ordered_json& grid) {
@@ -216,7 +46,8 @@ std::vector<Axis> axes_of(const ordered_json& grid) {
     const auto prefix = [&](const std::string& what) {
       return bad(fmt::format("key '{}': {}", name, what));
     };
-    if (kSweepOwned.count(name)) throw prefix(std::string(kSweepOwned.at(name)));
+    if (const std::string_view why = sweep_owned(name); !why.empty())
+      throw prefix(std::string(why));
     const KeyInfo* key = find_key(name);
     if (key == nullptr) {
       throw prefix(fmt::format("not an option of hnn train (the spec's keys: {}; grids, charts)",
@@ -292,57 +123,6 @@ std::vector<ordered_json> grids_of(const ordered_json& spec) {
 
 // ---- runs ----------------------------------------------------------------------------------
 
-std::string number_text(const ordered_json& v) {
-  return v.is_number_float() ? fmt::format("{}", v.get<double>()) : v.dump();
-}
-
-// How a value reads in `hnn train`'s arguments.
-std::vector<std::string> arg_values(const KeyInfo& key, const ordered_json& v) {
-  switch (key.kind) {
-    case Kind::kHidden: {
-      std::vector<std::string> widths;
-      for (const ordered_json& w : v) widths.push_back(w.dump());
-      return widths;
-    }
-    case Kind::kColumns:
-      return {fmt::format("{}", fmt::join(v.get<std::vector<std::string>>(), ","))};
-    case Kind::kObject:
-      return {v.dump()};
-    default:
-      return {v.is_string() ? v.get<std::string>() : number_text(v)};
-  }
-}
-
-// Characters safe in a folder name (and unquoted in a shell word); the rest become '-'.
-std::string folder_safe(const std::string& text) {
-  std::string s;
-  for (char c : text) {
-    const bool ok = std::isalnum(static_cast<unsigned char>(c)) ||
-                    std::string_view("._+=-").find(c) != std::string_view::npos;
-    if (ok)
-      s += c;
-    else if (!s.empty() && s.back() != '-')
-      s += '-';
-  }
-  while (!s.empty() && s.back() == '-') s.pop_back();
-  return s.empty() ? "-" : s;
-}
-
-std::string name_value(const KeyInfo& key, const ordered_json& v) {
-  switch (key.kind) {
-    case Kind::kHidden:
-      return tasks::join_widths(v.get<std::vector<int>>());
-    case Kind::kFile:
-      return folder_safe(fs::path(v.get<std::string>()).filename().string());
-    case Kind::kColumns:
-      return folder_safe(fmt::format("{}", fmt::join(v.get<std::vector<std::string>>(), "+")));
-    case Kind::kObject:
-      return folder_safe(v.dump());
-    default:
-      return folder_safe(v.is_string() ? v.get<std::string>() : number_text(v));
-  }
-}
-
 // FNV-1a: a stable short tag for names that would collide or run long.
 std::string hash_tag(const std::string& text) {
   std::uint64_t h = 1469598103934665603ull;
@@ -360,7 +140,7 @@ SweepRun build_run(const std::vector<std::pair<const KeyInfo*, ordered_json>>& c
   run.args = {o.task};
   std::vector<std::string> tags;
   json data_settings = json::object();
-  for (const KeyInfo& key : kKeys) {
+  for (const KeyInfo& key : key_table()) {
     if (!by_name.count(key.name)) continue;
     const ordered_json& v = by_name.at(key.name);
     run.values[std::string(key.name)] = v;
@@ -375,36 +155,7 @@ SweepRun build_run(const std::vector<std::pair<const KeyInfo*, ordered_json>>& c
       data_settings[std::string(key.data_setting)] = v;
       continue;
     }
-    switch (key.kind) {
-      case Kind::kModel:
-        o.model = tasks::parse_model(v.get<std::string>());
-        break;
-      case Kind::kSeed:
-        o.seed = v.get<std::uint64_t>();
-        break;
-      case Kind::kDtype:
-        o.dtype = tasks::parse_dtype(v.get<std::string>());
-        break;
-      case Kind::kPreset:
-        o.preset = tasks::parse_preset(v.get<std::string>());
-        break;
-      case Kind::kHidden:
-        o.hidden = v.get<std::vector<int>>();
-        break;
-      case Kind::kFile:
-        o.data_file = v.get<std::string>();
-        break;
-      case Kind::kObject:
-        o.task_settings = json::parse(v.dump());
-        break;
-      case Kind::kPositiveReal:
-        o.learning_rate = v.get<double>();
-        break;
-      default:
-        if (key.name == "steps") o.steps = v.get<int>();
-        if (key.name == "batch") o.batch_size = v.get<int>();
-        if (key.name == "checkpoint-every") o.checkpoint_every = v.get<long>();
-    }
+    apply_value(key, v, o);
   }
   o.task_settings.update(data_settings);  // as `hnn train` puts its data options over --settings
   std::string rest = tags.empty() ? "default" : fmt::format("{}", fmt::join(tags, ","));
@@ -517,12 +268,6 @@ ordered_json from_yaml(const YAML::Node& node) {
 
 }  // namespace
 
-std::vector<std::string> spec_keys() {
-  std::vector<std::string> names;
-  for (const KeyInfo& k : kKeys) names.emplace_back(k.name);
-  return names;
-}
-
 ordered_json read_spec(const fs::path& file) {
   const std::string where = fmt::format("sweep spec {}", file.string());
   std::ifstream in(file);
@@ -585,7 +330,7 @@ SweepPlan expand(const ordered_json& spec, const std::string& where, const fs::p
   for (const SweepRun& r : plan.runs) ++count[r.name];
   for (SweepRun& r : plan.runs)
     if (count[r.name] > 1) r.name += "~" + hash_tag(r.settings.dump());
-  for (const KeyInfo& k : kKeys)
+  for (const KeyInfo& k : key_table())
     if (used_keys.count(std::string(k.name))) plan.keys.emplace_back(k.name);
   try {
     plan.charts = checked_charts(spec, used_keys);

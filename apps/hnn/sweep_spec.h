@@ -35,7 +35,4 @@ nlohmann::ordered_json read_spec(const std::filesystem::path& file);
 SweepPlan expand(const nlohmann::ordered_json& spec, const std::string& where,
                  const std::filesystem::path& out);
 
-/// The option names a spec may use, in the canonical order of run names and table columns.
-std::vector<std::string> spec_keys();
-
 }  // namespace hnn::app::sweep
