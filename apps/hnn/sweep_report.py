@@ -62,7 +62,8 @@ def write_table(plan):
                      "values": r["values"],
                      "metrics": found if status == "done" else None,
                      "sweep": read_json(os.path.join(out, "runs", r["name"], "sweep.json"))})
-    counts = {s: sum(1 for row in rows if row["status"] == s) for s in ("done", "failed", "pending")}
+    counts = {s: sum(1 for row in rows if row["status"] == s)
+              for s in ("done", "failed", "pending")}
     document = {"spec": plan["spec"], "out": out, "written": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
                 "counts": counts, "keys": plan["keys"], "runs": rows}
     write_atomic(os.path.join(out, "results.json"), json.dumps(document, indent=1) + "\n")

@@ -87,7 +87,8 @@ class SpecErrors(SweepCase):
         ('{"task": ["spring"], "steps": ["200"]}', "json", "key 'steps': expected an integer"),
         ('{"task": ["spring"], "steps": 200}', "json", "key 'steps': expected a list of values"),
         ('{"task": ["spring"], "lr": [0]}', "json", "key 'lr': expected a finite number > 0"),
-        ('{"task": ["spring"], "hidden": [16, 16]}', "json", "key 'hidden': the value 16 is listed"),
+        ('{"task": ["spring"], "hidden": [16, 16]}', "json",
+         "key 'hidden': the value 16 is listed"),
         ('{"task": ["spring"], "hidden": [["a"]]}', "json", "key 'hidden': expected hidden widths"),
         ('{"task": ["spring"], "model": ["mlp"]}', "json", "key 'model': unknown model 'mlp'"),
         ('{"task": ["spring"], "dtype": [32]}', "json", "key 'dtype': expected a dtype"),
@@ -215,7 +216,8 @@ charts:
         self.assertEqual("hnn: error: " + failed["reason"], direct.stderr.strip())
         self.assertIn(f"failed: {failed['run']}: {failed['reason']}", result.stdout)
         self.assertTrue(os.path.exists(os.path.join(out, "chart-1.png")))
-        self.assertTrue(read_text(os.path.join(out, "results.csv")).startswith("run,status,reason,"))
+        self.assertTrue(
+            read_text(os.path.join(out, "results.csv")).startswith("run,status,reason,"))
 
         # Again: nothing runs (the failure is reported, not retried), still exit 1.
         before = events(out)
@@ -353,6 +355,56 @@ class Cluster(SweepCase):
         self.assertIn("all 12 runs are finished (0 failed): nothing to run", again.stdout)
         self.assertEqual(events(out), log)
         self.assertLess(time.time() - start, 30)
+
+
+class Expansion(SweepCase):
+    """How a spec becomes runs: hnn train's arguments, folder names, grids, duplicates."""
+
+    def listed(self, spec_text, ext="json"):
+        spec = write(self.path(f"s.{ext}"), spec_text)
+        result = hnn("sweep", spec, "--out", self.path("out"), "--list", cwd=self.dir)
+        self.assertEqual(result.returncode, 0, result.stderr)
+        self.assertFalse(os.path.exists(self.path("out")), "--list writes nothing")
+        return [shlex.split(line) for line in result.stdout.splitlines()]
+
+    def test_values_become_hnn_train_arguments_and_folder_names(self):
+        runs = self.listed(json.dumps({
+            "task": ["data"], "data": ["sub/my data.csv"], "coords": ["q1,q2", ["a", "b"]],
+            "momenta": [["p1", "p2"]], "test-fraction": [0.25], "lr": [0.001, 1e-05],
+            "settings": [{"threshold": 0.2}]}))
+        self.assertEqual(len(runs), 4)
+        data = os.path.join(self.dir, "sub", "my data.csv")
+        self.assertEqual(runs[0][:3], ["hnn", "train", "data"])
+        self.assertEqual(runs[0][3:], [
+            "--lr", "0.001", "--data", data, "--settings", '{"threshold":0.2}', "--coords", "q1,q2",
+            "--momenta", "p1,p2", "--test-fraction", "0.25", "--threads", "1", "--quiet",
+            "--out", self.path("out", "runs", "data", "hnn",
+                               "lr=0.001,data=my-data.csv,settings=threshold-0.2,coords=q1+q2,"
+                               "momenta=p1+p2,test-fraction=0.25")])
+        self.assertEqual(runs[1][runs[1].index("--lr") + 1], "1e-05")
+        self.assertEqual(runs[2][runs[2].index("--coords") + 1], "a,b")
+
+    def test_grids_share_keys_and_a_run_asked_twice_is_one_run(self):
+        runs = self.listed("""
+steps: [10]
+grids:
+  - {task: [spring], hidden: [[16, 16], 8]}
+  - {task: [spring], hidden: [[16, 16]], seed: [0]}
+  - {task: [pendulum]}
+""", ext="yaml")
+        folders = [r[r.index("--out") + 1].split("/runs/")[1] for r in runs]
+        # seed 0 is the default: the second grid's run is the first grid's first run.
+        self.assertEqual(folders, ["spring/hnn/hidden=16-16,steps=10",
+                                   "spring/hnn/hidden=8,steps=10", "pendulum/hnn/steps=10"])
+
+    def test_runs_that_read_alike_get_a_tag_each(self):
+        os.makedirs(self.path("a"))
+        os.makedirs(self.path("b"))
+        runs = self.listed('{"task": ["real-pendulum"], "data": ["a/x.txt", "b/x.txt"]}')
+        folders = [r[r.index("--out") + 1].rsplit("/", 1)[1] for r in runs]
+        self.assertEqual(len(set(folders)), 2)
+        for f in folders:
+            self.assertRegex(f, r"^data=x\.txt~[0-9a-f]{8}$")
 
 
 class ShippedSpecs(SweepCase):
