@@ -118,6 +118,8 @@ class SpecErrors(SweepCase):
                 self.assertFalse(os.path.exists(out), "a bad spec must write nothing")
 
     def test_bad_options(self):
+        self.assert_one_line_error(hnn("sweep", self.path("none.json"), "--out", self.path("o")),
+                                   "spec: File does not exist: ")
         spec = write(self.path("ok.json"), '{"task": ["spring"]}')
         self.assert_one_line_error(hnn("sweep", spec, "--out", self.path("o"), "--emit", "pbs"),
                                    "--emit")
