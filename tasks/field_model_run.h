@@ -46,7 +46,6 @@ class FieldModelRun : public TaskRun {
   RunSettings s_;
   Dataset data_;  ///< what the model trains on, in its own units
 
- private:
   template <typename T>
   std::unique_ptr<nn::DynamicsModel<T>> fresh_model() const {
     nn::DynamicsConfig config{.model = s_.model, .dim = data_.train_x.cols()};
@@ -67,6 +66,7 @@ class FieldModelRun : public TaskRun {
     model_.keep(std::move(model), std::move(in_double));
   }
 
+ private:
   TrainedModel<nn::DynamicsModel> model_;
 };
 

@@ -11,8 +11,9 @@ namespace hnn::app {
 std::function<void(nlohmann::json&, const std::string&)> add_data_options(CLI::App& cmd) {
   struct Values {
     std::vector<std::string> coords, momenta, velocities, derivatives;
-    std::string time, trajectory, split, hamiltonian;
+    std::string time, trajectory, split, hamiltonian, loss, integrator;
     double test_fraction = 0;
+    int horizon = 0;
   };
   auto v = std::make_shared<Values>();
   const char* group = "The data task (hnn train data --data FILE)";
@@ -39,6 +40,15 @@ std::function<void(nlohmann::json&, const std::string&)> add_data_options(CLI::A
   cmd.add_option("--hamiltonian", v->hamiltonian,
                  "A known H over the state's column names, for the energy metric")
       ->group(group);
+  cmd.add_option("--loss", v->loss,
+                 "derivative (dx/dt targets) or rollout (from states alone: the model's field "
+                 "integrated --horizon steps, one per sampling interval)")
+      ->check(CLI::IsMember({"derivative", "rollout"}))
+      ->group(group);
+  cmd.add_option("--horizon", v->horizon, "Steps of the rollout loss (default 1)")
+      ->check(CLI::Range(1, 1000))
+      ->group(group);
+  cmd.add_option("--integrator", v->integrator, "The rollout loss's integrator: rk4")->group(group);
   // Writes the options given into the task's settings; refuses them for another task.
   return [v, &cmd](nlohmann::json& settings, const std::string& task) {
     const auto put = [&](const char* option, const char* key, const nlohmann::json& value) {
@@ -58,6 +68,9 @@ std::function<void(nlohmann::json&, const std::string&)> add_data_options(CLI::A
     put("--split", "split", v->split);
     put("--test-fraction", "test_fraction", v->test_fraction);
     put("--hamiltonian", "hamiltonian", v->hamiltonian);
+    put("--loss", "loss", v->loss);
+    put("--horizon", "horizon", v->horizon);
+    put("--integrator", "integrator", v->integrator);
   };
 }
 

@@ -105,6 +105,10 @@ MeasuredData split_trajectories(const MeasuredTrajectories& m, const SplitChoice
   for (const Segment& s : parts.test) {
     if (s.t.size() >= 2) out.held_out.push_back({s.trajectory, m.table.where(s.rows[0]), s.t, s.x});
   }
+  for (const Segment& s : parts.train) {
+    if (s.t.size() >= 2)
+      out.train_stretches.push_back({s.trajectory, m.table.where(s.rows[0]), s.t, s.x});
+  }
   out.source = m.table.source;
   out.state_names = m.state_names;
   out.coordinates = m.coordinates;

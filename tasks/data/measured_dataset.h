@@ -22,7 +22,7 @@ struct SplitChoice {
   double test_fraction = 0.2;  ///< of the trajectories, or of each trajectory's rows; in (0, 1)
 };
 
-/// One held-out stretch without a gap, to roll out over its own times.
+/// One stretch of a trajectory without a gap (held out, or for training through an integrator).
 struct HeldOut {
   double trajectory = 0;  ///< its trajectory id
   std::string where;      ///< its first row: "FILE:LINE" or "FILE: row R"
@@ -33,6 +33,7 @@ struct HeldOut {
 struct MeasuredData {
   Dataset data;                          ///< rows in trajectory, then time order
   std::vector<HeldOut> held_out;         ///< every test stretch of at least 2 points
+  std::vector<HeldOut> train_stretches;  ///< the same of the training rows (rollout losses)
   std::string source;                    ///< the file
   std::vector<std::string> state_names;  ///< coordinates, then momenta (or velocities)
   Eigen::Index coordinates = 0;
