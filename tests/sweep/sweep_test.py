@@ -227,6 +227,11 @@ charts:
         self.assertEqual(again.returncode, 1)
         self.assertIn("all 3 runs are finished (1 failed): nothing to run", again.stdout)
         self.assertEqual(events(out), before)
+        # --retry-failed runs that one again, and only that one.
+        retried = hnn("sweep", spec, "--out", out, "--retry-failed")
+        self.assertEqual(retried.returncode, 1)
+        self.assertEqual([(e["event"], e["run"]) for e in events(out)[len(before):]],
+                         [("start", failed["run"]), ("failed", failed["run"])])
 
 
     def test_a_folder_holding_another_run_is_refused_before_anything_runs(self):
