@@ -14,7 +14,7 @@ std::unique_ptr<Task> make_real_pendulum_task();   // real_pendulum.cpp
 std::unique_ptr<Task> make_two_body_task();        // nbody.cpp
 std::unique_ptr<Task> make_three_body_task();      // nbody.cpp
 std::unique_ptr<Task> make_pixel_pendulum_task();  // pixel_pendulum.cpp
-std::unique_ptr<Task> make_damped_spring_task();    // damped_spring.cpp
+std::unique_ptr<Task> make_damped_spring_task();   // damped_spring.cpp
 std::unique_ptr<Task> make_data_task();            // data_task.cpp
 
 }  // namespace hnn::tasks

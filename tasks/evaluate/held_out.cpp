@@ -54,10 +54,10 @@ void roll_out(const LearnedField& model, const Units& units, HeldOutRollout& r) 
 
 // The first time since the start at which the relative state error passes the threshold.
 void valid_time(const Units& units, double threshold, HeldOutRollout& r) {
-  const Batch z = units.to_model(r.truth), zhat = units.to_model(r.pred);
-  for (Eigen::Index k = 0; k < z.rows(); ++k) {
-    const double error = (zhat.row(k) - z.row(k)).norm() / (zhat.row(k).norm() + z.row(k).norm());
-    if (!(error <= threshold)) {  // NaN (a failed rollout) ends it too
+  const Eigen::VectorXd error =
+      relative_state_error(units.to_model(r.pred), units.to_model(r.truth));
+  for (Eigen::Index k = 0; k < error.size(); ++k) {
+    if (!(error(k) <= threshold)) {  // NaN (a failed rollout) ends it too
       r.valid_time = r.t(k) - r.t(0);
       return;
     }

@@ -137,6 +137,12 @@ double state_mse(const Rollouts& r) {
   return count > 0 ? sum / count : NAN;
 }
 
+Eigen::VectorXd relative_state_error(const Eigen::MatrixXd& pred, const Eigen::MatrixXd& truth) {
+  return ((pred - truth).rowwise().norm().array() /
+          (pred.rowwise().norm() + truth.rowwise().norm()).array())
+      .matrix();
+}
+
 RelativeError relative_error(const Rollouts& r, double threshold) {
   RelativeError out;
   double log_sum = 0, valid_sum = 0;
@@ -147,8 +153,9 @@ RelativeError relative_error(const Rollouts& r, double threshold) {
     const Eigen::MatrixXd& y = r.pred[i];
     double valid = r.t.back() - r.t.front();
     bool passed = false;
+    const Eigen::VectorXd error = relative_state_error(y, x);
     for (Eigen::Index k = 1; k < x.rows(); ++k) {
-      const double e = (y.row(k) - x.row(k)).norm() / (y.row(k).norm() + x.row(k).norm());
+      const double e = error(k);
       log_sum += std::log(std::max(e, 1e-300));
       ++count;
       if (!passed && !(e <= threshold)) {

@@ -73,6 +73,9 @@ double state_mse(const Rollouts& rollouts);
 /// true ones (Finzi et al. 2020): its geometric mean over every trajectory and time after the
 /// start, and the valid prediction time, the first time e passes `threshold` (mean over the
 /// trajectories; a trajectory that never passes it counts its whole span and is `censored`).
+/// |x^ - x| / (|x^| + |x|) of each row (time) of a predicted path against the true one.
+Eigen::VectorXd relative_state_error(const Eigen::MatrixXd& pred, const Eigen::MatrixXd& truth);
+
 struct RelativeError {
   double geomean = NAN, valid_time = NAN;
   int censored = 0;

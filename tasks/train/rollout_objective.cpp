@@ -41,14 +41,14 @@ RolloutWindows rollout_windows(const std::vector<Stretch>& stretches, int horizo
   RolloutWindows w;
   w.start.resize(count, dim);
   w.next.assign(std::size_t(horizon), Batch(count, dim));
-  w.step.assign(std::size_t(horizon), Eigen::VectorXd(count));
+  w.step.assign(std::size_t(horizon), Batch(count, 1));
   Eigen::Index row = 0;
   for (const Stretch& s : stretches) {
     for (Eigen::Index i = 0; i + horizon < s.x.rows(); ++i, ++row) {
       w.start.row(row) = s.x.row(i);
       for (int j = 0; j < horizon; ++j) {
         w.next[std::size_t(j)].row(row) = s.x.row(i + j + 1);
-        w.step[std::size_t(j)](row) = s.t(i + j + 1) - s.t(i + j);
+        w.step[std::size_t(j)](row, 0) = s.t(i + j + 1) - s.t(i + j);
       }
     }
   }
@@ -72,7 +72,7 @@ ad::Var<T> RolloutObjective<T>::loss(const RolloutWindows& w,
   ad::Var<T> x = constant_rows<T>(w.start, rows);
   ad::Var<T> total;
   for (std::size_t j = 0; j < w.next.size(); ++j) {
-    const ad::Var<T> h = constant_rows<T>(Batch(w.step[j]), rows);
+    const ad::Var<T> h = constant_rows<T>(w.step[j], rows);
     const ad::Var<T> half = h * T(0.5);
     const ad::Var<T> k1 = model_.time_derivative(x);
     const ad::Var<T> k2 = model_.time_derivative(x + half * k1);

@@ -24,8 +24,8 @@ struct Stretch {
 /// states after each step, and each step's length.
 struct RolloutWindows {
   Batch start;
-  std::vector<Batch> next;            ///< horizon matrices, windows x dim
-  std::vector<Eigen::VectorXd> step;  ///< horizon vectors, one length per window
+  std::vector<Batch> next;  ///< horizon matrices, windows x dim
+  std::vector<Batch> step;  ///< horizon columns (windows x 1), one length per window
   Eigen::Index count() const { return start.rows(); }
 };
 
