@@ -82,3 +82,47 @@ Batch DoublePendulum::sample_initial_states(int n, std::mt19937_64& rng) const {
 }
 
 }  // namespace hnn::physics
+
+namespace hnn::physics {
+
+DoublePendulumVelocities::DoublePendulumVelocities(double m1, double m2, double l1, double l2,
+                                                   double g)
+    : m1_(m1), m2_(m2), l1_(l1), l2_(l2), g_(g), canonical_(m1, m2, l1, l2, g) {}
+
+Eigen::VectorXd DoublePendulumVelocities::hamiltonian_batch(const Batch& x) const {
+  const Eigen::ArrayXd t1 = x.col(0).array(), t2 = x.col(1).array(), w1 = x.col(2).array(),
+                       w2 = x.col(3).array();
+  const Eigen::ArrayXd kinetic = 0.5 * (m1_ + m2_) * l1_ * l1_ * w1.square() +
+                                 0.5 * m2_ * l2_ * l2_ * w2.square() +
+                                 m2_ * l1_ * l2_ * w1 * w2 * (t1 - t2).cos();
+  const Eigen::ArrayXd potential =
+      (m1_ + m2_) * g_ * l1_ * (1.0 - t1.cos()) + m2_ * g_ * l2_ * (1.0 - t2.cos());
+  return (kinetic + potential).matrix();
+}
+
+// M(theta) alpha = f(theta, omega), M's rows normalised by their diagonals: alpha1 + a1 alpha2 =
+// f1 and a2 alpha1 + alpha2 = f2, solved in closed form (1 - a1 a2 = m1 / (m1 + m2 sin^2 d) > 0).
+void DoublePendulumVelocities::vector_field(const Batch& x, Batch& dxdt) const {
+  const Eigen::ArrayXd t1 = x.col(0).array(), t2 = x.col(1).array(), w1 = x.col(2).array(),
+                       w2 = x.col(3).array();
+  const Eigen::ArrayXd d = t1 - t2, c = d.cos(), s = d.sin();
+  const double mu = m2_ / (m1_ + m2_);
+  const Eigen::ArrayXd a1 = (l2_ / l1_) * mu * c, a2 = (l1_ / l2_) * c;
+  const Eigen::ArrayXd f1 = -(l2_ / l1_) * mu * w2.square() * s - (g_ / l1_) * t1.sin();
+  const Eigen::ArrayXd f2 = (l1_ / l2_) * w1.square() * s - (g_ / l2_) * t2.sin();
+  const Eigen::ArrayXd det = 1.0 - a1 * a2;
+  dxdt.resize(x.rows(), 4);
+  dxdt.col(0) = x.col(2);
+  dxdt.col(1) = x.col(3);
+  dxdt.col(2).array() = (f1 - a1 * f2) / det;
+  dxdt.col(3).array() = (f2 - a2 * f1) / det;
+}
+
+Batch DoublePendulumVelocities::sample_initial_states(int n, std::mt19937_64& rng) const {
+  std::uniform_real_distribution<double> angle(0.0, 2.0 * std::numbers::pi), speed(0.0, 0.1);
+  Batch x(n, 4);
+  for (int i = 0; i < n; ++i) x.row(i) << angle(rng), angle(rng), speed(rng), speed(rng);
+  return x;
+}
+
+}  // namespace hnn::physics

@@ -32,4 +32,29 @@ class DoublePendulum : public System {
   double m1_, m2_, l1_, l2_, g_;
 };
 
+/// The same double pendulum in angles and angular velocities x = (theta1, theta2, omega1,
+/// omega2), as a Lagrangian NN learns it (Cranmer et al. 2020): dx/dt = (omega, alpha) from the
+/// Euler-Lagrange equations, energy T + V as above (zero at rest). Not a canonical system:
+/// hamiltonian_batch is the energy in these coordinates, and the field is not its symplectic
+/// gradient.
+class DoublePendulumVelocities : public System {
+ public:
+  /// g = 9.8 by default, as in the LNN paper's experiment (whose energy scale is 3 g = 29.4).
+  DoublePendulumVelocities(double m1 = 1.0, double m2 = 1.0, double l1 = 1.0, double l2 = 1.0,
+                           double g = 9.8);
+
+  int dim() const override { return 4; }
+  std::string name() const override { return "double_pendulum_velocities"; }
+  Eigen::VectorXd hamiltonian_batch(const Batch& x) const override;
+  void vector_field(const Batch& x, Batch& dxdt) const override;
+  /// The LNN paper's test states: angles U[0, 2 pi), angular velocities U[0, 0.1).
+  Batch sample_initial_states(int n, std::mt19937_64& rng) const override;
+  /// The canonical system of the same pendulum, for conversions.
+  const DoublePendulum& canonical() const { return canonical_; }
+
+ private:
+  double m1_, m2_, l1_, l2_, g_;
+  DoublePendulum canonical_;
+};
+
 }  // namespace hnn::physics

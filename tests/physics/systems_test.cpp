@@ -8,6 +8,7 @@
 
 #include "physics/double_pendulum.h"
 #include "physics/gym_pendulum.h"
+#include "physics/integrator.h"
 #include "physics/nbody.h"
 #include "physics/oscillators.h"
 #include "physics_test_util.h"
@@ -204,6 +205,34 @@ TEST(DoublePendulum, VelocityMomentumRoundTripAndKineticEnergy) {
         2.0 * 9.81 * 0.9 * (1 - std::cos(v(k, 0))) + 0.8 * 9.81 * 1.1 * (1 - std::cos(v(k, 1)));
     EXPECT_NEAR(dp.hamiltonian(x.row(k)), kinetic + potential, 1e-12);
   }
+}
+
+// The pendulum in velocities must move exactly as the canonical one: integrate both from the same
+// states (converted) and compare; its energy must be the canonical H and stay constant.
+TEST(DoublePendulumVelocities, MovesAsTheCanonicalSystemAndConservesEnergy) {
+  const DoublePendulumVelocities lagrangian(1.2, 0.8, 0.9, 1.1, 9.8);
+  const DoublePendulum& canonical = lagrangian.canonical();
+  Batch v0(3, 4);
+  v0 << 0.3, -0.4, 1.5, -2.0, 2.0, 1.0, 0.1, 0.2, -1.0, 2.5, -0.7, 1.3;
+  const auto dopri = make_integrator("dopri5", {.rtol = 1e-12, .atol = 1e-13});
+  const std::vector<double> t = linspace(0.0, 3.0, 4);
+  const Trajectory in_velocities = dopri->integrate(lagrangian.field(), v0, t);
+  const Trajectory in_momenta =
+      dopri->integrate(canonical.field(), canonical.momenta_from_velocities(v0), t);
+  for (std::size_t k = 0; k < t.size(); ++k) {
+    const Batch converted = canonical.velocities_from_momenta(in_momenta.states[k]);
+    EXPECT_LT((in_velocities.states[k] - converted).cwiseAbs().maxCoeff(), 1e-8) << "t = " << t[k];
+    EXPECT_LT((lagrangian.hamiltonian_batch(in_velocities.states[k]) -
+               canonical.hamiltonian_batch(in_momenta.states[k]))
+                  .cwiseAbs()
+                  .maxCoeff(),
+              1e-9);
+  }
+  EXPECT_LT((lagrangian.hamiltonian_batch(in_velocities.states.back()) -
+             lagrangian.hamiltonian_batch(v0))
+                .cwiseAbs()
+                .maxCoeff(),
+            1e-9);
 }
 
 }  // namespace
