@@ -3,16 +3,20 @@
 #include <fmt/format.h>
 
 #include <array>
+#include <numbers>
 #include <stdexcept>
+
+#include "autodiff/ops.h"
 
 namespace hnn::nn {
 
 namespace {
 
-constexpr std::array<std::pair<ModelKind, std::string_view>, 3> kKindNames{{
+constexpr std::array<std::pair<ModelKind, std::string_view>, 4> kKindNames{{
     {ModelKind::kHnn, "hnn"},
     {ModelKind::kBaseline, "baseline"},
     {ModelKind::kDhnn, "dhnn"},
+    {ModelKind::kLnn, "lnn"},
 }};
 constexpr std::array<std::pair<FieldType, std::string_view>, 3> kFieldNames{{
     {FieldType::kSolenoidal, "solenoidal"},
@@ -62,6 +66,16 @@ void validate(const DynamicsConfig& config) {
     throw std::invalid_argument(
         fmt::format("model: an HNN needs an even state dimension x = (q, p), got {}", config.dim));
   }
+  if (config.model == ModelKind::kLnn && config.dim % 2 != 0) {
+    throw std::invalid_argument(
+        fmt::format("model: an LNN needs an even state dimension x = (q, v), got {}", config.dim));
+  }
+  if (config.angles < 0 || 2 * config.angles > config.dim) {
+    throw std::invalid_argument(fmt::format(
+        "model: {} angle coordinates do not fit a state of dimension {} (angles are coordinates "
+        "q, the first half)",
+        config.angles, config.dim));
+  }
 }
 
 MlpConfig mlp_config(const DynamicsConfig& config) {
@@ -71,6 +85,7 @@ MlpConfig mlp_config(const DynamicsConfig& config) {
   mlp.widths.insert(mlp.widths.end(), config.hidden.begin(), config.hidden.end());
   Index out = config.dim;
   if (learns_scalars(config.model)) out = config.field == FieldType::kBoth ? 2 : 1;
+  if (config.model == ModelKind::kLnn) out = 1;
   mlp.widths.push_back(out);
   mlp.activation = config.activation;
   mlp.init = config.init;
@@ -93,6 +108,7 @@ DynamicsModel<T>::DynamicsModel(DynamicsConfig config, Mlp<T> mlp)
 template <typename T>
 std::string DynamicsModel<T>::name() const {
   if (config_.model == ModelKind::kBaseline) return "baseline";
+  if (config_.model == ModelKind::kLnn) return "lnn";
   switch (config_.field) {
     case FieldType::kSolenoidal:
       return "hnn";
@@ -125,6 +141,17 @@ void DynamicsModel<T>::check_input(const char* what, Index rows, Index cols) con
     throw ad::Error(fmt::format("{}.{}: input is {} but the model takes R x {}", name(), what,
                                 ad::shape_str(rows, cols), config_.dim));
   }
+}
+
+template <typename T>
+ad::Var<T> DynamicsModel<T>::wrap_angles(const ad::Var<T>& x) const {
+  if (config_.angles == 0) return x;
+  constexpr double kTwoPi = 2 * std::numbers::pi;
+  Matrix<T> shift = Matrix<T>::Zero(x.rows(), x.cols());
+  shift.leftCols(config_.angles) =
+      (x.value().leftCols(config_.angles).array() + T(std::numbers::pi)) / T(kTwoPi);
+  shift.leftCols(config_.angles) = shift.leftCols(config_.angles).array().floor() * T(kTwoPi);
+  return x - ad::Var<T>::constant(shift);
 }
 
 template class DynamicsModel<float>;

@@ -15,6 +15,7 @@ enum class ModelKind {
   kHnn,       // a learned scalar; dx/dt from its derivatives (the field type below)
   kBaseline,  // an MLP that outputs dx/dt directly
   kDhnn,      // the dissipative HNN (Sosanya & Greydanus 2022): an HNN whose field type is kBoth
+  kLnn,       // the Lagrangian NN (Cranmer et al. 2020): a learned L(q, v), x = (q, v = dq/dt)
 };
 
 /// How an HNN turns learned scalars into a field (the reference's field_type).
@@ -24,10 +25,14 @@ enum class FieldType {
   kBoth,          // (dH/dp, -dH/dq) + dD/dx: the dissipative extension (friction)
 };
 
-/// Whether a model of this kind is an Hnn (learns scalars whose gradients give the field).
-inline bool learns_scalars(ModelKind kind) { return kind != ModelKind::kBaseline; }
+/// Whether a model of this kind is an Hnn (learns H, and D, whose gradients give the field).
+inline bool learns_scalars(ModelKind kind) {
+  return kind == ModelKind::kHnn || kind == ModelKind::kDhnn;
+}
+/// Whether the state's second half is velocities dq/dt (an LNN's), not canonical momenta.
+inline bool needs_velocities(ModelKind kind) { return kind == ModelKind::kLnn; }
 
-/// "hnn", "baseline", "dhnn"; "solenoidal", "conservative", "both".
+/// "hnn", "baseline", "dhnn", "lnn"; "solenoidal", "conservative", "both".
 std::string_view to_string(ModelKind kind);
 std::string_view to_string(FieldType field);
 /// Inverses of to_string; throw std::invalid_argument listing the valid names.
@@ -43,10 +48,13 @@ struct DynamicsConfig {
   Activation activation = Activation::kTanh;
   Init init = Init::kOrthogonal;
   FieldType field = FieldType::kSolenoidal;  // HNN only; a kDhnn's must be kBoth
+  /// The first `angles` coordinates are angles: the MLP sees them wrapped to [-pi, pi), so a
+  /// model of a pendulum is periodic in them (the derivative of the wrap is 1).
+  Index angles = 0;
 };
 
-/// The MLP of a model: dim -> hidden... -> out, with out = dim for the baseline and the number of
-/// learned scalars for an HNN (1, or 2 for kBoth: column 0 is H, column 1 is D).
+/// The MLP of a model: dim -> hidden... -> out, with out = dim for the baseline, the number of
+/// learned scalars for an HNN (1, or 2 for kBoth: column 0 is H, column 1 is D), 1 (L) for an LNN.
 MlpConfig mlp_config(const DynamicsConfig& config);
 /// Throws std::invalid_argument when the config cannot make a model (odd HNN dim, ...).
 void validate(const DynamicsConfig& config);
@@ -66,7 +74,7 @@ class DynamicsModel : public Module<T> {
   const DynamicsConfig& config() const { return config_; }
   Index dim() const { return config_.dim; }
   const Mlp<T>& mlp() const { return mlp_; }
-  /// "hnn", "hnn-conservative", "hnn-dissipative" (kBoth) or "baseline".
+  /// "hnn", "hnn-conservative", "hnn-dissipative" (kBoth), "lnn" or "baseline".
   std::string name() const;
   /// name() + ":" + activation, e.g. "hnn:tanh": what checkpoints record and check.
   std::string kind() const override;
@@ -81,6 +89,9 @@ class DynamicsModel : public Module<T> {
   DynamicsModel& operator=(DynamicsModel&&) noexcept = default;
   /// Throws ad::Error unless x is R x dim.
   void check_input(const char* what, Index rows, Index cols) const;
+  /// x with its angle coordinates wrapped to [-pi, pi) (x itself when there are none): what the
+  /// MLP sees. The shift is a constant, so derivatives pass through unchanged.
+  ad::Var<T> wrap_angles(const ad::Var<T>& x) const;
 
   DynamicsConfig config_;
   Mlp<T> mlp_;

@@ -6,6 +6,7 @@
 
 #include "autodiff/ops.h"
 #include "autodiff/tape.h"
+#include "nn/lnn.h"
 
 namespace hnn::nn {
 
@@ -13,7 +14,7 @@ namespace {
 
 // An Hnn is built from a kHnn or kDhnn config, a Baseline from a kBaseline one.
 const DynamicsConfig& require(const DynamicsConfig& config, ModelKind kind) {
-  if (learns_scalars(config.model) != learns_scalars(kind)) {
+  if (learns_scalars(config.model) != learns_scalars(kind) || config.model == ModelKind::kLnn) {
     throw std::invalid_argument(fmt::format("a {} model cannot be built from a '{}' config",
                                             to_string(kind), to_string(config.model)));
   }
@@ -51,7 +52,7 @@ ad::Var<T> Hnn<T>::energy(const ad::Var<T>& x) const {
   if (this->config_.field == FieldType::kConservative) {
     throw std::logic_error("hnn-conservative: the model learns no Hamiltonian, only D");
   }
-  const ad::Var<T> out = this->mlp_.forward(x);
+  const ad::Var<T> out = this->mlp_.forward(this->wrap_angles(x));
   return out.cols() == 1 ? out : ad::slice_cols(out, 0, 1);
 }
 
@@ -68,7 +69,7 @@ ad::Var<T> Hnn<T>::dissipation(const ad::Var<T>& x) const {
   if (this->config_.field == FieldType::kSolenoidal) {
     throw std::logic_error("hnn: a solenoidal HNN learns no dissipation potential D");
   }
-  const ad::Var<T> out = this->mlp_.forward(x);
+  const ad::Var<T> out = this->mlp_.forward(this->wrap_angles(x));
   return out.cols() == 1 ? out : ad::slice_cols(out, 1, 1);
 }
 
@@ -79,12 +80,13 @@ template <typename T>
 typename Hnn<T>::Parts Hnn<T>::time_derivative_parts(const ad::Var<T>& x) const {
   this->check_input("time_derivative", x.rows(), x.cols());
   const FieldType field = this->config_.field;
+  const ad::Var<T> in = this->wrap_angles(x);
   Parts parts;
   if (field != FieldType::kConservative) {
-    parts.solenoidal = symplectic_gradient(this->mlp_.input_gradient(x, 0));
+    parts.solenoidal = symplectic_gradient(this->mlp_.input_gradient(in, 0));
   }
   if (field != FieldType::kSolenoidal) {
-    parts.conservative = this->mlp_.input_gradient(x, this->mlp_.output_dim() - 1);
+    parts.conservative = this->mlp_.input_gradient(in, this->mlp_.output_dim() - 1);
   }
   return parts;
 }
@@ -119,7 +121,7 @@ Baseline<T>::Baseline(DynamicsConfig config, Mlp<T> mlp)
 template <typename T>
 ad::Var<T> Baseline<T>::time_derivative(const ad::Var<T>& x) const {
   this->check_input("time_derivative", x.rows(), x.cols());
-  return this->mlp_.forward(x);
+  return this->mlp_.forward(this->wrap_angles(x));
 }
 
 template <typename T>
@@ -127,13 +129,14 @@ Matrix<T> Baseline<T>::field(const Matrix<T>& x) const {
   this->check_input("field", x.rows(), x.cols());
   ad::TapeScope scope;
   ad::NoGradGuard values_only;
-  return this->mlp_.forward(ad::Var<T>::constant(x)).value();
+  return this->mlp_.forward(this->wrap_angles(ad::Var<T>::constant(x))).value();
 }
 
 // ---- factory ------------------------------------------------------------------------------
 
 template <typename T>
 std::unique_ptr<DynamicsModel<T>> make_model(const DynamicsConfig& config, std::mt19937_64& rng) {
+  if (config.model == ModelKind::kLnn) return std::make_unique<Lnn<T>>(config, rng);
   if (learns_scalars(config.model)) return std::make_unique<Hnn<T>>(config, rng);
   return std::make_unique<Baseline<T>>(config, rng);
 }
@@ -141,6 +144,9 @@ std::unique_ptr<DynamicsModel<T>> make_model(const DynamicsConfig& config, std::
 template <typename U, typename T>
 std::unique_ptr<DynamicsModel<U>> cast_model(const DynamicsModel<T>& model) {
   Mlp<U> mlp = model.mlp().template cast<U>();
+  if (model.config().model == ModelKind::kLnn) {
+    return std::make_unique<Lnn<U>>(model.config(), std::move(mlp));
+  }
   if (learns_scalars(model.config().model)) {
     return std::make_unique<Hnn<U>>(model.config(), std::move(mlp));
   }

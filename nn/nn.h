@@ -8,6 +8,7 @@
 #include "nn/hnn.h"
 #include "nn/init.h"
 #include "nn/linear.h"
+#include "nn/lnn.h"
 #include "nn/loss.h"
 #include "nn/mlp.h"
 #include "nn/module.h"

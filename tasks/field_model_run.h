@@ -36,8 +36,9 @@ class FieldModelRun : public TaskRun {
  protected:
   /// Checks the batch size against the data before a run folder exists: a bad one leaves
   /// nothing behind.
-  FieldModelRun(RunSettings settings, Dataset data)
-      : s_(std::move(settings)), data_(std::move(data)) {
+  /// `angles`: how many leading coordinates the models see wrapped to [-pi, pi).
+  FieldModelRun(RunSettings settings, Dataset data, Eigen::Index angles = 0)
+      : s_(std::move(settings)), data_(std::move(data)), angles_(angles) {
     HNN_TASKS_CHECK(s_.train.batch_size <= data_.train_x.rows(),
                     "--batch {} is larger than the training set ({} rows)", s_.train.batch_size,
                     data_.train_x.rows());
@@ -45,10 +46,11 @@ class FieldModelRun : public TaskRun {
 
   RunSettings s_;
   Dataset data_;  ///< what the model trains on, in its own units
+  Eigen::Index angles_;
 
   template <typename T>
   std::unique_ptr<nn::DynamicsModel<T>> fresh_model() const {
-    nn::DynamicsConfig config{.model = s_.model, .dim = data_.train_x.cols()};
+    nn::DynamicsConfig config{.model = s_.model, .dim = data_.train_x.cols(), .angles = angles_};
     if (s_.model == nn::ModelKind::kDhnn) config.field = nn::FieldType::kBoth;
     config.hidden.assign(s_.train.hidden.begin(), s_.train.hidden.end());
     try {

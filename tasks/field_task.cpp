@@ -15,12 +15,14 @@ namespace {
 class FieldRun : public FieldModelRun {
  public:
   FieldRun(const FieldTask& task, RunSettings settings)
-      : FieldModelRun(settings, task.build_dataset(settings)), task_(task) {}
+      : FieldModelRun(settings, task.build_dataset(settings), task.angle_coordinates()),
+        task_(task) {}
 
   nlohmann::json evaluate(const RunFolder* folder) const override {
     const RolloutConfig config = task_.rollout_config();
-    const FieldEvaluation e = evaluate_field_model(task_.truth(), dynamics(), data_,
-                                                   rollout_states(config.trajectories), config);
+    FieldEvaluation e = evaluate_field_model(task_.truth(), dynamics(), data_,
+                                             rollout_states(config.trajectories), config);
+    task_.add_metrics(e.rollouts, e.metrics);
     if (folder) folder->write_text("rollout.csv", tasks::rollout_csv(e.rollouts));
     return e.metrics;
   }
@@ -48,6 +50,8 @@ class FieldRun : public FieldModelRun {
 };
 
 }  // namespace
+
+void FieldTask::add_metrics(const Rollouts&, nlohmann::json&) const {}
 
 std::unique_ptr<TaskRun> FieldTask::open(const RunSettings& settings) const {
   return std::make_unique<FieldRun>(*this, settings);

@@ -26,6 +26,11 @@ class FieldTask : public Task {
   /// Initial states of the energy-metric rollouts.
   virtual Batch rollout_states(const Dataset& data, std::mt19937_64& rng) const = 0;
   virtual RolloutConfig rollout_config() const { return {}; }
+  /// Metrics of the task's own protocol from the evaluation's rollouts (a peer's), added to
+  /// metrics.json; by default none.
+  virtual void add_metrics(const Rollouts& rollouts, nlohmann::json& metrics) const;
+  /// How many leading coordinates are angles (the models see them wrapped); by default none.
+  virtual Eigen::Index angle_coordinates() const { return 0; }
 
   /// A FieldRun of this task; the task must outlive it.
   std::unique_ptr<TaskRun> open(const RunSettings& settings) const override;

@@ -71,7 +71,7 @@ std::string_view to_string(Dtype dtype) { return dtype == Dtype::kFloat ? "float
 std::string_view to_string(Preset preset) { return preset == Preset::kLean ? "lean" : "paper"; }
 std::vector<std::string> dtype_names() { return {"float", "double"}; }
 std::vector<std::string> preset_names() { return {"paper", "lean"}; }
-std::vector<std::string> model_names() { return {"hnn", "baseline", "dhnn"}; }
+std::vector<std::string> model_names() { return {"hnn", "baseline", "dhnn", "lnn"}; }
 
 Dtype parse_dtype(std::string_view name) {
   if (name == "float") return Dtype::kFloat;

@@ -22,6 +22,7 @@ const std::vector<std::pair<std::string, Factory>>& registry() {
       {"three-body", make_three_body_task},
       {"pixel-pendulum", make_pixel_pendulum_task},
       {"damped-spring", make_damped_spring_task},
+      {"double-pendulum", make_double_pendulum_task},
       {"data", make_data_task}};
   return tasks;
 }
@@ -47,10 +48,7 @@ std::vector<std::string> task_names() {
 }
 
 std::vector<std::string> paper_task_names() {
-  std::vector<std::string> names = task_names();
-  for (const char* other : {"damped-spring", "data"})
-    names.erase(std::remove(names.begin(), names.end(), other), names.end());
-  return names;
+  return {"spring", "pendulum", "real-pendulum", "two-body", "three-body", "pixel-pendulum"};
 }
 
 std::unique_ptr<Task> make_task(const std::string& name) {

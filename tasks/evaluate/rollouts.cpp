@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "nn/hnn.h"
+#include "nn/lnn.h"
 #include "physics/integrator.h"
 #include "physics/types.h"
 
@@ -60,6 +61,11 @@ LearnedField learned_field(const nn::DynamicsModel<double>& model) {
   if (hnn != nullptr && model.config().field != nn::FieldType::kConservative)
     learned.hamiltonian = [hnn](const Batch& x) -> Eigen::VectorXd {
       return hnn->energy(x).col(0);
+    };
+  // An LNN's conserved quantity: its learned energy v · dL/dv - L.
+  if (const auto* lnn = dynamic_cast<const nn::Lnn<double>*>(&model))
+    learned.hamiltonian = [lnn](const Batch& x) -> Eigen::VectorXd {
+      return lnn->energy(x).col(0);
     };
   return learned;
 }
@@ -125,6 +131,18 @@ nn::MeanStderr energy_mse(const Rollouts& r) {
   const double spread = std::sqrt((means.array() - means.mean()).square().mean());
   out.std_error = splits > 1 ? spread / std::sqrt(double(splits)) : NAN;
   return out;
+}
+
+nn::MeanStderr energy_error_at_end(const Rollouts& r, double scale) {
+  std::vector<double> errors;
+  const Eigen::Index end = r.true_energy.cols() - 1;
+  for (std::size_t i = 0; i < r.failed.size(); ++i) {
+    const Eigen::Index row = Eigen::Index(i);
+    if (!r.failed[i]) errors.push_back(std::abs(r.pred_energy(row, end) - r.true_energy(row, end)) / scale);
+  }
+  if (errors.empty()) return {.mean = NAN, .std_error = NAN, .count = 0};
+  return nn::mean_and_stderr<double>(
+      Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(errors.data(), Eigen::Index(errors.size()))));
 }
 
 double state_mse(const Rollouts& r) {

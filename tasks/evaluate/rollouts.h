@@ -65,6 +65,11 @@ Rollouts make_rollouts(const physics::System& truth, const LearnedField& learned
 /// from 5 interleaved splits of the trajectories (the reference's "bootstrap" of 5 splits).
 nn::MeanStderr energy_mse(const Rollouts& rollouts);
 
+/// |E_pred(T) - E_true(T)| / scale at the last time T, mean over the learned rollouts that did
+/// not fail, with the standard error std / sqrt(n): the LNN paper's energy metric (scale 29.4 for
+/// its double pendulum). NaN when all failed.
+nn::MeanStderr energy_error_at_end(const Rollouts& rollouts, double scale);
+
 /// Mean over the learned rollouts that did not fail, their times and every state component of
 /// the squared state error (the dissipative-HNN paper's state MSE); NaN when all failed.
 double state_mse(const Rollouts& rollouts);

@@ -1,0 +1,100 @@
+#include "nn/lnn.h"
+
+#include <fmt/format.h>
+
+#include <stdexcept>
+#include <vector>
+
+#include "autodiff/functional.h"
+#include "autodiff/grad.h"
+#include "autodiff/ops.h"
+#include "autodiff/tape.h"
+
+namespace hnn::nn {
+
+namespace {
+
+const DynamicsConfig& require_lnn(const DynamicsConfig& config) {
+  if (config.model != ModelKind::kLnn) {
+    throw std::invalid_argument(
+        fmt::format("an lnn model cannot be built from a '{}' config", to_string(config.model)));
+  }
+  validate(config);
+  return config;
+}
+
+// The n x n blocks [j][i] = jacobian[j][offset + i] of a row-wise Jacobian R x (n · 2n), each
+// block flattened row-major: the v-v or v-q part of the Hessian of L.
+template <typename T>
+ad::Var<T> hessian_block(const ad::Var<T>& jacobian, Index n, Index offset) {
+  std::vector<ad::Var<T>> rows;
+  rows.reserve(std::size_t(n));
+  for (Index j = 0; j < n; ++j) rows.push_back(ad::slice_cols(jacobian, j * 2 * n + offset, n));
+  return ad::concat_cols<T>(rows);
+}
+
+}  // namespace
+
+template <typename T>
+Lnn<T>::Lnn(DynamicsConfig config, std::mt19937_64& rng)
+    : DynamicsModel<T>(require_lnn(config), Mlp<T>(mlp_config(require_lnn(config)), rng)) {}
+
+template <typename T>
+Lnn<T>::Lnn(DynamicsConfig config, Mlp<T> mlp)
+    : DynamicsModel<T>(require_lnn(config), std::move(mlp)) {}
+
+template <typename T>
+ad::Var<T> Lnn<T>::lagrangian(const ad::Var<T>& x) const {
+  this->check_input("lagrangian", x.rows(), x.cols());
+  return this->mlp_.forward(this->wrap_angles(x));
+}
+
+template <typename T>
+Matrix<T> Lnn<T>::energy(const Matrix<T>& x) const {
+  this->check_input("energy", x.rows(), x.cols());
+  ad::TapeScope scope;
+  ad::GradModeGuard record(true);
+  const Index n = x.cols() / 2;
+  const ad::Var<T> in = ad::Var<T>::leaf(x);
+  const ad::Var<T> dl = this->mlp_.input_gradient(this->wrap_angles(in), 0);
+  const Matrix<T> v = x.rightCols(n);
+  return (v.cwiseProduct(dl.value().rightCols(n)).rowwise().sum() -
+          this->mlp_.forward(this->wrap_angles(in)).value())
+      .eval();
+}
+
+// The Euler-Lagrange equations, d/dt dL/dv = dL/dq, expanded: (d²L/dv²) a + (d²L/dv dq) v = dL/dq.
+// dL/dx is one input gradient; the Hessian rows of its v-part are n more reverse passes over
+// the batch (row_jacobian), recorded when the caller records (training differentiates them).
+template <typename T>
+ad::Var<T> Lnn<T>::time_derivative(const ad::Var<T>& x) const {
+  this->check_input("time_derivative", x.rows(), x.cols());
+  const bool record = ad::grad_enabled();
+  const Index n = x.cols() / 2;
+  ad::GradModeGuard inner(true);  // the Hessians need dL/dx on the tape even for values only
+  // Differentiating with respect to x needs x to require gradients: a constant batch becomes a
+  // leaf (its copy is the only cost).
+  const ad::Var<T> in = x.requires_grad() ? x : ad::Var<T>::leaf(x.value());
+  const ad::Var<T> dl = this->mlp_.input_gradient(this->wrap_angles(in), 0);
+  const ad::Var<T> dl_dv = ad::slice_cols(dl, n, n);
+  const ad::Var<T> jacobian = ad::row_jacobian(dl_dv, in, {.create_graph = record});
+  ad::GradModeGuard outer(record);
+  const ad::Var<T> v = ad::slice_cols(x, n, n);
+  const ad::Var<T> dl_dq = ad::slice_cols(dl, 0, n);
+  const ad::Var<T> force = dl_dq - ad::batched_matvec(hessian_block(jacobian, n, 0), v);
+  const ad::Var<T> a = ad::batched_solve(hessian_block(jacobian, n, n), force);
+  return ad::concat_cols<T>({v, a});
+}
+
+template <typename T>
+Matrix<T> Lnn<T>::field(const Matrix<T>& x) const {
+  this->check_input("field", x.rows(), x.cols());
+  ad::TapeScope scope;
+  ad::NoGradGuard values_only;
+  return time_derivative(ad::Var<T>::constant(x)).value();
+}
+
+template class Lnn<float>;
+template class Lnn<double>;
+
+}  // namespace hnn::nn

@@ -1,0 +1,40 @@
+#pragma once
+// The Lagrangian neural network (Cranmer et al. 2020): an MLP maps x = (q, v), v = dq/dt, to a
+// learned Lagrangian L, and the motion follows from the Euler-Lagrange equations,
+//   dv/dt = (d²L/dv²)⁻¹ (dL/dq - (d²L/dv dq) v),
+// solved row by row. Training differentiates through the per-sample Hessian blocks and the
+// solve, a third-order path through the MLP.
+
+#include <random>
+
+#include "nn/dynamics.h"
+
+namespace hnn::nn {
+
+template <typename T>
+class Lnn : public DynamicsModel<T> {
+ public:
+  /// config.model must be kLnn. Parameters initialised from `rng`.
+  Lnn(DynamicsConfig config, std::mt19937_64& rng);
+  /// An LNN with the given MLP, which must match mlp_config(config).
+  Lnn(DynamicsConfig config, Mlp<T> mlp);
+  Lnn(Lnn&&) noexcept = default;
+  Lnn& operator=(Lnn&&) noexcept = default;
+
+  /// The learned Lagrangian L(q, v), R x 1.
+  ad::Var<T> lagrangian(const ad::Var<T>& x) const;
+  /// The learned energy E = v · dL/dv - L, R x 1: what the learned motion conserves.
+  Matrix<T> energy(const Matrix<T>& x) const;
+
+  /// (v, dv/dt). Throws ad::Error naming the row when a block d²L/dv² is singular or
+  /// ill-conditioned (the learned L has no well-defined motion there).
+  ad::Var<T> time_derivative(const ad::Var<T>& x) const override;
+  Matrix<T> field(const Matrix<T>& x) const override;
+
+  template <typename U>
+  Lnn<U> cast() const {
+    return Lnn<U>(this->config_, this->mlp_.template cast<U>());
+  }
+};
+
+}  // namespace hnn::nn
