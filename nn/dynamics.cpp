@@ -1,8 +1,11 @@
 #include "nn/dynamics.h"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <numbers>
 #include <stdexcept>
 
@@ -69,6 +72,14 @@ void validate(const DynamicsConfig& config) {
   if (config.model == ModelKind::kLnn && config.dim % 2 != 0) {
     throw std::invalid_argument(
         fmt::format("model: an LNN needs an even state dimension x = (q, v), got {}", config.dim));
+  }
+  const bool scales_ok = std::all_of(config.input_scale.begin(), config.input_scale.end(),
+                                     [](double s) { return s > 0 && std::isfinite(s); });
+  if (!(config.input_scale.empty() || Index(config.input_scale.size()) == config.dim) ||
+      !scales_ok) {
+    throw std::invalid_argument(fmt::format(
+        "model: input_scale needs one positive, finite scale per coordinate ({}), got [{}]",
+        config.dim, fmt::join(config.input_scale, ", ")));
   }
   if (config.angles < 0 || 2 * config.angles > config.dim) {
     throw std::invalid_argument(fmt::format(
@@ -144,14 +155,22 @@ void DynamicsModel<T>::check_input(const char* what, Index rows, Index cols) con
 }
 
 template <typename T>
-ad::Var<T> DynamicsModel<T>::wrap_angles(const ad::Var<T>& x) const {
-  if (config_.angles == 0) return x;
-  constexpr double kTwoPi = 2 * std::numbers::pi;
-  Matrix<T> shift = Matrix<T>::Zero(x.rows(), x.cols());
-  shift.leftCols(config_.angles) =
-      (x.value().leftCols(config_.angles).array() + T(std::numbers::pi)) / T(kTwoPi);
-  shift.leftCols(config_.angles) = shift.leftCols(config_.angles).array().floor() * T(kTwoPi);
-  return x - ad::Var<T>::constant(shift);
+ad::Var<T> DynamicsModel<T>::mlp_input(const ad::Var<T>& x) const {
+  ad::Var<T> in = x;
+  if (config_.angles > 0) {
+    constexpr double kTwoPi = 2 * std::numbers::pi;
+    Matrix<T> shift = Matrix<T>::Zero(x.rows(), x.cols());
+    shift.leftCols(config_.angles) =
+        (x.value().leftCols(config_.angles).array() + T(std::numbers::pi)) / T(kTwoPi);
+    shift.leftCols(config_.angles) = shift.leftCols(config_.angles).array().floor() * T(kTwoPi);
+    in = in - ad::Var<T>::constant(shift);
+  }
+  if (!config_.input_scale.empty()) {
+    const Eigen::Map<const Eigen::RowVectorXd> scale(config_.input_scale.data(),
+                                                     Eigen::Index(config_.input_scale.size()));
+    in = in * ad::Var<T>::constant(Matrix<T>(scale.cwiseInverse().template cast<T>()));
+  }
+  return in;
 }
 
 template class DynamicsModel<float>;

@@ -51,6 +51,9 @@ struct DynamicsConfig {
   /// The first `angles` coordinates are angles: the MLP sees them wrapped to [-pi, pi), so a
   /// model of a pendulum is periodic in them (the derivative of the wrap is 1).
   Index angles = 0;
+  /// Empty, or one positive scale per coordinate: the MLP sees x / scale, so inputs of very
+  /// different sizes (angular velocities of 10 beside angles of 1) do not saturate it.
+  std::vector<double> input_scale{};
 };
 
 /// The MLP of a model: dim -> hidden... -> out, with out = dim for the baseline, the number of
@@ -89,9 +92,10 @@ class DynamicsModel : public Module<T> {
   DynamicsModel& operator=(DynamicsModel&&) noexcept = default;
   /// Throws ad::Error unless x is R x dim.
   void check_input(const char* what, Index rows, Index cols) const;
-  /// x with its angle coordinates wrapped to [-pi, pi) (x itself when there are none): what the
-  /// MLP sees. The shift is a constant, so derivatives pass through unchanged.
-  ad::Var<T> wrap_angles(const ad::Var<T>& x) const;
+  /// What the MLP sees: x with its angle coordinates wrapped to [-pi, pi), divided by the input
+  /// scales (x itself when there are neither). The wrap is a constant shift and the scale a
+  /// constant factor, so derivatives with respect to x pass through exactly.
+  ad::Var<T> mlp_input(const ad::Var<T>& x) const;
 
   DynamicsConfig config_;
   Mlp<T> mlp_;

@@ -52,7 +52,7 @@ ad::Var<T> Hnn<T>::energy(const ad::Var<T>& x) const {
   if (this->config_.field == FieldType::kConservative) {
     throw std::logic_error("hnn-conservative: the model learns no Hamiltonian, only D");
   }
-  const ad::Var<T> out = this->mlp_.forward(this->wrap_angles(x));
+  const ad::Var<T> out = this->mlp_.forward(this->mlp_input(x));
   return out.cols() == 1 ? out : ad::slice_cols(out, 0, 1);
 }
 
@@ -69,7 +69,7 @@ ad::Var<T> Hnn<T>::dissipation(const ad::Var<T>& x) const {
   if (this->config_.field == FieldType::kSolenoidal) {
     throw std::logic_error("hnn: a solenoidal HNN learns no dissipation potential D");
   }
-  const ad::Var<T> out = this->mlp_.forward(this->wrap_angles(x));
+  const ad::Var<T> out = this->mlp_.forward(this->mlp_input(x));
   return out.cols() == 1 ? out : ad::slice_cols(out, 1, 1);
 }
 
@@ -80,7 +80,7 @@ template <typename T>
 typename Hnn<T>::Parts Hnn<T>::time_derivative_parts(const ad::Var<T>& x) const {
   this->check_input("time_derivative", x.rows(), x.cols());
   const FieldType field = this->config_.field;
-  const ad::Var<T> in = this->wrap_angles(x);
+  const ad::Var<T> in = this->mlp_input(x);
   Parts parts;
   if (field != FieldType::kConservative) {
     parts.solenoidal = symplectic_gradient(this->mlp_.input_gradient(in, 0));
@@ -121,7 +121,7 @@ Baseline<T>::Baseline(DynamicsConfig config, Mlp<T> mlp)
 template <typename T>
 ad::Var<T> Baseline<T>::time_derivative(const ad::Var<T>& x) const {
   this->check_input("time_derivative", x.rows(), x.cols());
-  return this->mlp_.forward(this->wrap_angles(x));
+  return this->mlp_.forward(this->mlp_input(x));
 }
 
 template <typename T>
@@ -129,7 +129,7 @@ Matrix<T> Baseline<T>::field(const Matrix<T>& x) const {
   this->check_input("field", x.rows(), x.cols());
   ad::TapeScope scope;
   ad::NoGradGuard values_only;
-  return this->mlp_.forward(this->wrap_angles(ad::Var<T>::constant(x))).value();
+  return this->mlp_.forward(this->mlp_input(ad::Var<T>::constant(x))).value();
 }
 
 // ---- factory ------------------------------------------------------------------------------

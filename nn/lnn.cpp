@@ -46,7 +46,7 @@ Lnn<T>::Lnn(DynamicsConfig config, Mlp<T> mlp)
 template <typename T>
 ad::Var<T> Lnn<T>::lagrangian(const ad::Var<T>& x) const {
   this->check_input("lagrangian", x.rows(), x.cols());
-  return this->mlp_.forward(this->wrap_angles(x));
+  return this->mlp_.forward(this->mlp_input(x));
 }
 
 template <typename T>
@@ -56,10 +56,10 @@ Matrix<T> Lnn<T>::energy(const Matrix<T>& x) const {
   ad::GradModeGuard record(true);
   const Index n = x.cols() / 2;
   const ad::Var<T> in = ad::Var<T>::leaf(x);
-  const ad::Var<T> dl = this->mlp_.input_gradient(this->wrap_angles(in), 0);
+  const ad::Var<T> dl = this->mlp_.input_gradient(this->mlp_input(in), 0);
   const Matrix<T> v = x.rightCols(n);
   return (v.cwiseProduct(dl.value().rightCols(n)).rowwise().sum() -
-          this->mlp_.forward(this->wrap_angles(in)).value())
+          this->mlp_.forward(this->mlp_input(in)).value())
       .eval();
 }
 
@@ -75,7 +75,7 @@ ad::Var<T> Lnn<T>::time_derivative(const ad::Var<T>& x) const {
   // Differentiating with respect to x needs x to require gradients: a constant batch becomes a
   // leaf (its copy is the only cost).
   const ad::Var<T> in = x.requires_grad() ? x : ad::Var<T>::leaf(x.value());
-  const ad::Var<T> dl = this->mlp_.input_gradient(this->wrap_angles(in), 0);
+  const ad::Var<T> dl = this->mlp_.input_gradient(this->mlp_input(in), 0);
   const ad::Var<T> dl_dv = ad::slice_cols(dl, n, n);
   const ad::Var<T> jacobian = ad::row_jacobian(dl_dv, in, {.create_graph = record});
   ad::GradModeGuard outer(record);

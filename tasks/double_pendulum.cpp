@@ -38,6 +38,8 @@ class DoublePendulumTask : public FieldTask {
     return {nn::ModelKind::kLnn, nn::ModelKind::kBaseline};
   }
   Eigen::Index angle_coordinates() const override { return 2; }
+  // Angular velocities reach 10: the models see them divided by 10, like the angles, O(1).
+  std::vector<double> input_scale() const override { return {1, 1, kMaxSpeed, kMaxSpeed}; }
 
   Dataset build_dataset(const RunSettings& settings) const override {
     std::mt19937_64 rng(settings.seed);

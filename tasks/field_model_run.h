@@ -10,6 +10,12 @@
 
 namespace hnn::tasks {
 
+/// How the models see their inputs (angle coordinates, input scales), as the task says.
+struct ModelInput {
+  Eigen::Index angles = 0;
+  std::vector<double> input_scale{};
+};
+
 class FieldModelRun : public TaskRun {
  public:
   TrainResult train(const LoopOptions& loop) override {
@@ -36,9 +42,8 @@ class FieldModelRun : public TaskRun {
  protected:
   /// Checks the batch size against the data before a run folder exists: a bad one leaves
   /// nothing behind.
-  /// `angles`: how many leading coordinates the models see wrapped to [-pi, pi).
-  FieldModelRun(RunSettings settings, Dataset data, Eigen::Index angles = 0)
-      : s_(std::move(settings)), data_(std::move(data)), angles_(angles) {
+  FieldModelRun(RunSettings settings, Dataset data, ModelInput input = {})
+      : s_(std::move(settings)), data_(std::move(data)), input_(std::move(input)) {
     HNN_TASKS_CHECK(s_.train.batch_size <= data_.train_x.rows(),
                     "--batch {} is larger than the training set ({} rows)", s_.train.batch_size,
                     data_.train_x.rows());
@@ -46,11 +51,14 @@ class FieldModelRun : public TaskRun {
 
   RunSettings s_;
   Dataset data_;  ///< what the model trains on, in its own units
-  Eigen::Index angles_;
+  ModelInput input_;
 
   template <typename T>
   std::unique_ptr<nn::DynamicsModel<T>> fresh_model() const {
-    nn::DynamicsConfig config{.model = s_.model, .dim = data_.train_x.cols(), .angles = angles_};
+    nn::DynamicsConfig config{.model = s_.model,
+                              .dim = data_.train_x.cols(),
+                              .angles = input_.angles,
+                              .input_scale = input_.input_scale};
     if (s_.model == nn::ModelKind::kDhnn) config.field = nn::FieldType::kBoth;
     config.hidden.assign(s_.train.hidden.begin(), s_.train.hidden.end());
     try {

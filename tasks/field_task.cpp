@@ -15,7 +15,8 @@ namespace {
 class FieldRun : public FieldModelRun {
  public:
   FieldRun(const FieldTask& task, RunSettings settings)
-      : FieldModelRun(settings, task.build_dataset(settings), task.angle_coordinates()),
+      : FieldModelRun(settings, task.build_dataset(settings),
+                      {.angles = task.angle_coordinates(), .input_scale = task.input_scale()}),
         task_(task) {}
 
   nlohmann::json evaluate(const RunFolder* folder) const override {

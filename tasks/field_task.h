@@ -31,6 +31,8 @@ class FieldTask : public Task {
   virtual void add_metrics(const Rollouts& rollouts, nlohmann::json& metrics) const;
   /// How many leading coordinates are angles (the models see them wrapped); by default none.
   virtual Eigen::Index angle_coordinates() const { return 0; }
+  /// The models' input scales (nn::DynamicsConfig::input_scale); by default none.
+  virtual std::vector<double> input_scale() const { return {}; }
 
   /// A FieldRun of this task; the task must outlive it.
   std::unique_ptr<TaskRun> open(const RunSettings& settings) const override;
