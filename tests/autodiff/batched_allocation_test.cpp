@@ -76,8 +76,7 @@ long AllocationsOfSolveSteps(Eigen::Index rows, Eigen::Index n, int warmup, int 
       ad::TapeScope scope;
       const Var<T> x = ad::batched_solve(inputs[0], inputs[1]);
       ad::grad_into(ad::sum(ad::square(x)), inputs, first, {.create_graph = true});
-      ad::grad_into(ad::sum(ad::square(first[0])) + ad::sum(ad::square(first[1])), inputs,
-                    second);
+      ad::grad_into(ad::sum(ad::square(first[0])) + ad::sum(ad::square(first[1])), inputs, second);
     }
     if (step >= warmup) counted += g_allocations.load() - before;
   }

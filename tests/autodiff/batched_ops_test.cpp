@@ -77,15 +77,17 @@ std::vector<BatchedCase> AllCases() {
   cases.push_back({"Matvec_rectangular_transposed",
                    [](const Inputs& in) { return ad::batched_matvec(in[0], in[1], true); },
                    {random_matrix(3, 6, 52), random_matrix(3, 3, 53)}});
-  cases.push_back({"Outer_3x2", [](const Inputs& in) { return ad::batched_outer(in[0], in[1]); },
+  cases.push_back({"Outer_3x2",
+                   [](const Inputs& in) { return ad::batched_outer(in[0], in[1]); },
                    {random_matrix(3, 3, 60), random_matrix(3, 2, 61)}});
-  cases.push_back({"Outer_1x1", [](const Inputs& in) { return ad::batched_outer(in[0], in[1]); },
+  cases.push_back({"Outer_1x1",
+                   [](const Inputs& in) { return ad::batched_outer(in[0], in[1]); },
                    {random_matrix(4, 1, 62), random_matrix(4, 1, 63)}});
   // A solve whose operands are themselves computed: the chain through both inputs.
   cases.push_back({"Solve_of_outer_plus_identity",
                    [](const Inputs& in) {
-                     const VarD a = ad::batched_outer(in[0], in[1]) + VarD::constant(
-                         WellConditionedBlocks(2, 2, 70));
+                     const VarD a = ad::batched_outer(in[0], in[1]) +
+                                    VarD::constant(WellConditionedBlocks(2, 2, 70));
                      return ad::batched_solve(a, ad::tanh(in[2]));
                    },
                    {random_matrix(2, 2, 71, -0.4, 0.4), random_matrix(2, 2, 72, -0.4, 0.4),
@@ -124,8 +126,8 @@ TEST(BatchedSolve, ThirdDerivativesMatchFiniteDifferencesOfTheSecond) {
       const VarD loss = ad::sum(ad::sin(ad::batched_solve(in[0], in[1], t)));
       return ad::grad<double>({loss}, in, {.create_graph = true});
     };
-    const ad::CheckResult r = ad::gradgradcheck(
-        gradient, {WellConditionedBlocks(2, 2, 80), random_matrix(2, 2, 81)});
+    const ad::CheckResult r =
+        ad::gradgradcheck(gradient, {WellConditionedBlocks(2, 2, 80), random_matrix(2, 2, 81)});
     EXPECT_TRUE(r.ok) << (t ? "transposed: " : "") << r.worst << "\n" << r.log;
   }
 }
@@ -137,13 +139,12 @@ TEST(BatchedSolve, MatchesEigenBlockByBlock) {
         ad::TapeScope scope;
         const MatrixD a = WellConditionedBlocks(rows, n, unsigned(100 + n));
         const MatrixD b = random_matrix(rows, n, unsigned(200 + n));
-        const MatrixD x =
-            ad::batched_solve(VarD::constant(a), VarD::constant(b), t).value();
+        const MatrixD x = ad::batched_solve(VarD::constant(a), VarD::constant(b), t).value();
         ASSERT_EQ(x.rows(), rows);
         ASSERT_EQ(x.cols(), n);
         for (Eigen::Index r = 0; r < rows; ++r) {
-          const Eigen::MatrixXd block = t ? Eigen::MatrixXd(Block(a, r, n).transpose())
-                                          : Block(a, r, n);
+          const Eigen::MatrixXd block =
+              t ? Eigen::MatrixXd(Block(a, r, n).transpose()) : Block(a, r, n);
           const Eigen::VectorXd expected = block.fullPivLu().solve(b.row(r).transpose());
           ASSERT_LT((x.row(r).transpose() - expected).norm(), 1e-13 * expected.norm() + 1e-15)
               << "n " << n << ", R " << rows << (t ? ", transposed" : "") << ", row " << r;
@@ -201,8 +202,7 @@ TEST(BatchedSolve, ThresholdIsPerPrecision) {
   }
   const std::string message = ErrorOf([&] {
     ad::TapeScope scope;
-    ad::batched_solve(Var<float>::constant(a.cast<float>()),
-                      Var<float>::constant(b.cast<float>()));
+    ad::batched_solve(Var<float>::constant(a.cast<float>()), Var<float>::constant(b.cast<float>()));
   });
   EXPECT_TRUE(Contains(message, "block 0 of 1 is singular or ill-conditioned")) << message;
 }
@@ -267,8 +267,7 @@ TEST(BatchedOps, FloatSmokeTest) {
   const std::vector<Var<float>> g = ad::grad<float>({loss}, {af, bf});
 
   const VarD ad_ = VarD::leaf(a), bd = VarD::leaf(b);
-  const VarD loss_d =
-      ad::sum(ad::square(ad::batched_outer(ad::batched_solve(ad_, bd), bd)));
+  const VarD loss_d = ad::sum(ad::square(ad::batched_outer(ad::batched_solve(ad_, bd), bd)));
   const std::vector<VarD> gd = ad::grad<double>({loss_d}, {ad_, bd});
   EXPECT_LT(ad::testing::relative_error(g[0].value().cast<double>(), gd[0].value()), 1e-5);
   EXPECT_LT(ad::testing::relative_error(g[1].value().cast<double>(), gd[1].value()), 1e-5);
