@@ -59,9 +59,10 @@ template <typename T> Var<T> linear(const Var<T>& x, const Var<T>& w, const Var<
 // Row r of `a` holds a small matrix A_r flattened row-major (n x n: R x n^2), row r of a vector
 // operand holds v_r. These are the per-sample Hessian blocks of a Lagrangian network.
 
-/// batched_solve refuses a block whose reciprocal condition number (1-norm, Eigen's estimate)
-/// is below this: 1000 epsilons, 2.2e-13 in double and 1.2e-4 in float. There the solution has
-/// no correct digits left (relative error ~ eps / rcond), so a NaN-free result would be a lie.
+/// batched_solve refuses a block whose reciprocal condition number 1 / (|A|_1 |A^-1|_1) is below
+/// this (exact for blocks up to 4x4, Eigen's estimate above): 1000 epsilons, 2.2e-13 in double
+/// and 1.2e-4 in float. There the solution has no correct digits left (relative error ~ eps /
+/// rcond), so a NaN-free result would be a lie.
 template <typename T>
 inline constexpr T kBatchedSolveMinRcond = T(1000) * std::numeric_limits<T>::epsilon();
 

