@@ -23,6 +23,7 @@ import warnings
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import sweep_report  # noqa: E402  (beside this file, in the source tree and in share/hnn)
+# compare_report, beside it too, is imported by finish() for the plans of `hnn compare`.
 
 STATUS_EVERY = 30.0  # seconds between status lines when no run ends
 STATUS_GAP = 2.0  # at least this many seconds between status lines as runs end
@@ -298,6 +299,10 @@ def finish(plan):
     table = sweep_report.write_table(plan)
     for path in sweep_report.write_charts(plan, table):
         say(f"chart {path}")
+    if "compare" in plan:  # hnn compare: its report over the table
+        import compare_report
+        for path in compare_report.write(plan, table):
+            print(f"hnn compare: {path}", flush=True)
     failed = [row for row in table if row["status"] == "failed"]
     pending = [row for row in table if row["status"] == "pending"]
     for row in failed:
