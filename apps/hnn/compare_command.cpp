@@ -67,8 +67,8 @@ void check_names(const std::vector<std::string>& given, const std::vector<std::s
                  const char* option, const char* what) {
   for (const std::string& name : given) {
     if (!contains(known, name)) {
-      throw std::invalid_argument(fmt::format("compare: {}: unknown {} '{}' (hnn's {}s: {})",
-                                              option, what, name, what, fmt::join(known, ", ")));
+      throw std::invalid_argument(fmt::format("compare: {}: unknown {} '{}' (known: {})", option,
+                                              what, name, fmt::join(known, ", ")));
     }
   }
 }
