@@ -206,6 +206,10 @@ json read_peers(const fs::path& file) {
   return doc;
 }
 
+constexpr const char* kTable1Protocol =
+    "the HNN paper's settings (each task's defaults); train and test loss: MSE of dx/dt over the "
+    "split; energy: MSE of the true energy along true and learned rollouts";
+
 // The HNN paper's Table 1 for the study's paper tasks: Task::paper(), the numbers `hnn
 // reproduce` sets beside its own.
 json table1_peers(const std::vector<Row>& rows) {
@@ -217,10 +221,9 @@ json table1_peers(const std::vector<Row>& rows) {
     const auto task = tasks::make_task(row.task);
     for (const nn::ModelKind model : {nn::ModelKind::kBaseline, nn::ModelKind::kHnn}) {
       const tasks::PaperRow paper = task->paper(model);
-      const std::pair<const char*, tasks::PaperValue> values[] = {
-          {"train_loss", paper.train_loss},
-          {"test_loss", paper.test_loss},
-          {"energy_mse", paper.energy_mse}};
+      const std::pair<const char*, tasks::PaperValue> values[] = {{"train_loss", paper.train_loss},
+                                                                  {"test_loss", paper.test_loss},
+                                                                  {"energy_mse", paper.energy_mse}};
       for (const auto& [metric, v] : values) {
         out.push_back({{"peer", "HNN (Greydanus et al. 2019)"},
                        {"source", "the HNN paper's Table 1 (hnn: Task::paper() of tasks/" +
@@ -232,7 +235,8 @@ json table1_peers(const std::vector<Row>& rows) {
                        {"metric", metric},
                        {"value", v.mean},
                        {"se", v.se},
-                       {"n", "the paper's seeds"}});
+                       {"n", "the paper's seeds"},
+                       {"protocol", kTable1Protocol}});
       }
     }
   }

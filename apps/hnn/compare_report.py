@@ -148,7 +148,10 @@ def markdown(doc):
     md = [f"# hnn compare\n",
           f"`{doc['command']}`\n",
           f"Ours: the mean ± standard error over the seeds that finished (of {doc['seeds']} per "
-          f"row: seeds 0..{doc['seeds'] - 1}; steps: {doc['steps']}), one line per metric of "
+          f"row: seeds 0..{doc['seeds'] - 1}; steps: {doc['steps']}"
+          + ("" if isinstance(doc["steps"], str) else
+             ", not each task's default: the peers' numbers are at their own settings")
+          + "), one line per metric of "
           "metrics.json. Peers: their published number on the same metric and protocol, from "
           f"`{os.path.basename(doc['peers_file'])}` (its entries name their sources; the HNN "
           "paper's Table 1 comes from each task, as in `hnn reproduce`). A peer number whose "

@@ -161,9 +161,9 @@ void list_runs(const SweepPlan& plan, const LaunchOptions& o, const fs::path& ou
 
 void check_scheduler(const std::string& scheduler) {
   if (!scheduler.empty() && scheduler.find("://") == std::string::npos) {
-    throw std::invalid_argument(fmt::format(
-        "--scheduler expects a Dask scheduler's address like tcp://HOST:8786, got '{}'",
-        scheduler));
+    throw std::invalid_argument(
+        fmt::format("--scheduler expects a Dask scheduler's address like tcp://HOST:8786, got '{}'",
+                    scheduler));
   }
 }
 
