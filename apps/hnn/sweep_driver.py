@@ -10,7 +10,8 @@ with one single-threaded worker per --threads-per-run cores, or the --scheduler'
 must see OUT at the same path). A run with a checkpoint resumes from it (`hnn train --resume`),
 so a run whose worker died goes on elsewhere from its last checkpoint; Dask resubmits it. A run
 that fails for its own reasons (exit 1, "hnn: error: ...") is reported with that line and does
-not stop the sweep. Each run appends its events to OUT/events.jsonl.
+not stop the sweep. Each run appends its events to OUT/events.jsonl. A plan written by
+`hnn compare` has a "compare" section: its report (compare_report.py) is written with the table.
 """
 
 import json
