@@ -26,5 +26,8 @@ void add_simulate_command(CLI::App& app);
 void add_export_command(CLI::App& app);
 /// sweep: a grid of runs from a spec file, through Dask (apps/hnn/sweep_command.cpp).
 void add_sweep_command(CLI::App& app);
+/// compare: the model families on a study's tasks beside the peers' published numbers, through
+/// the sweep engine (apps/hnn/compare_command.cpp); argv is kept for the report.
+void add_compare_command(CLI::App& app, int argc, char** argv);
 
 }  // namespace hnn::app

@@ -43,7 +43,7 @@ std::function<void(nlohmann::json&, const std::string&)> add_data_options(CLI::A
   cmd.add_option("--loss", v->loss,
                  "derivative (dx/dt targets) or rollout (from states alone: the model's field "
                  "integrated --horizon steps, one per sampling interval)")
-      ->check(CLI::IsMember({"derivative", "rollout"}))
+      ->check(CLI::IsMember(loss_names()))
       ->group(group);
   cmd.add_option("--horizon", v->horizon, "Steps of the rollout loss (default 1)")
       ->check(CLI::Range(1, 1000))

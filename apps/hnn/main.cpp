@@ -236,6 +236,7 @@ int main(int argc, char** argv) {
   hnn::app::add_simulate_command(app);
   hnn::app::add_export_command(app);
   hnn::app::add_sweep_command(app);
+  hnn::app::add_compare_command(app, argc, argv);
   try {
     app.parse(argc, argv);
   } catch (const CLI::RuntimeError& e) {

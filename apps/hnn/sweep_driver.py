@@ -10,7 +10,8 @@ with one single-threaded worker per --threads-per-run cores, or the --scheduler'
 must see OUT at the same path). A run with a checkpoint resumes from it (`hnn train --resume`),
 so a run whose worker died goes on elsewhere from its last checkpoint; Dask resubmits it. A run
 that fails for its own reasons (exit 1, "hnn: error: ...") is reported with that line and does
-not stop the sweep. Each run appends its events to OUT/events.jsonl.
+not stop the sweep. Each run appends its events to OUT/events.jsonl. A plan written by
+`hnn compare` has a "compare" section: its report (compare_report.py) is written with the table.
 """
 
 import json
@@ -23,6 +24,7 @@ import warnings
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import sweep_report  # noqa: E402  (beside this file, in the source tree and in share/hnn)
+# compare_report, beside it too, is imported by finish() for the plans of `hnn compare`.
 
 STATUS_EVERY = 30.0  # seconds between status lines when no run ends
 STATUS_GAP = 2.0  # at least this many seconds between status lines as runs end
@@ -298,6 +300,10 @@ def finish(plan):
     table = sweep_report.write_table(plan)
     for path in sweep_report.write_charts(plan, table):
         say(f"chart {path}")
+    if "compare" in plan:  # hnn compare: its report over the table
+        import compare_report
+        for path in compare_report.write(plan, table):
+            print(f"hnn compare: {path}", flush=True)
     failed = [row for row in table if row["status"] == "failed"]
     pending = [row for row in table if row["status"] == "pending"]
     for row in failed:

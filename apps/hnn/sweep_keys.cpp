@@ -13,6 +13,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "apps/hnn/validators.h"
 #include "tasks/task.h"
 
 namespace hnn::app::sweep {
@@ -46,6 +47,9 @@ constexpr KeyInfo kKeys[] = {
     {"split", Kind::kSplit, "split"},
     {"test-fraction", Kind::kFraction, "test_fraction"},
     {"hamiltonian", Kind::kText, "hamiltonian"},
+    {"loss", Kind::kLoss, "loss"},
+    {"horizon", Kind::kPositiveInt, "horizon"},
+    {"integrator", Kind::kText, "integrator"},
 };
 
 // Options of `hnn train` that the sweep sets itself.
@@ -134,6 +138,8 @@ ordered_json checked_value(const KeyInfo& key, const ordered_json& v) {
       return one_of(v, tasks::preset_names(), "preset");
     case Kind::kSplit:
       return one_of(v, {"auto", "trajectories", "time"}, "split");
+    case Kind::kLoss:
+      return one_of(v, loss_names(), "loss");
     case Kind::kSeed:
       if (v.is_number_unsigned()) return v;
       throw bad(

@@ -28,7 +28,8 @@ enum class Kind {
   kColumns,
   kText,
   kSplit,
-  kFraction
+  kFraction,
+  kLoss
 };
 
 /// One key: its name, its kind, and the data task's settings key it fills (or "").

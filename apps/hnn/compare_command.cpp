@@ -1,0 +1,350 @@
+// `hnn compare`: every (task, model, loss) of a study for N seeds, run through the sweep engine
+// (the same run folders, Dask driver, resume and lock as `hnn sweep`), then a table of ours beside
+// the peers' published numbers (apps/hnn/compare_report.py, called by the driver at the end).
+// Which pairs run is decided by hnn itself: each is expanded and checked as `hnn sweep` checks a
+// run (tasks::validate), and a pair that fails is a "skipped: <reason>" row of the table.
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <fstream>
+#include <set>
+
+#include "apps/hnn/commands.h"
+#include "apps/hnn/sweep_keys.h"
+#include "apps/hnn/sweep_launch.h"
+#include "apps/hnn/validators.h"
+#include "tasks/task.h"
+
+namespace hnn::app {
+
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+using nlohmann::ordered_json;
+
+/// --quick: steps of every run (a smoke run of the whole study).
+constexpr int kQuickSteps = 100;
+
+struct CompareOptions {
+  std::vector<std::string> tasks, models, losses;
+  int seeds = 3, steps = 0;
+  std::string out;
+  bool quick = false, list = false;
+  sweep::LaunchOptions launch;
+  std::string command;  // the command line, for the report
+};
+
+// Tasks x models x losses, crossed.
+struct Group {
+  std::vector<std::string> tasks, models, losses;
+};
+
+// The default study: the tasks where each family matters. Names this hnn lacks (a family still
+// to come) become skipped rows saying so, not errors.
+std::vector<Group> default_study() {
+  return {{{"real-pendulum", "damped-spring"}, {"baseline", "hnn", "dhnn"}, {"derivative"}},
+          {{"double-pendulum"}, {"baseline", "hnn", "lnn"}, {"derivative"}},
+          {{"three-body", "spring"}, {"baseline", "hnn"}, {"derivative", "rollout"}}};
+}
+
+// One row of the table: a (task, model, loss) and its runs, or why it does not run.
+struct Row {
+  std::string task, model, loss;
+  std::string skipped;  // "": runs
+  std::vector<std::string> runs;
+};
+
+bool contains(const std::vector<std::string>& names, const std::string& name) {
+  return std::find(names.begin(), names.end(), name) != names.end();
+}
+
+void check_names(const std::vector<std::string>& given, const std::vector<std::string>& known,
+                 const char* option, const char* what) {
+  for (const std::string& name : given) {
+    if (!contains(known, name)) {
+      throw std::invalid_argument(fmt::format("compare: {}: unknown {} '{}' (known: {})", option,
+                                              what, name, fmt::join(known, ", ")));
+    }
+  }
+}
+
+// The study's groups: --tasks x --models x --loss, or the default study narrowed to the --models
+// and --loss given.
+std::vector<Group> study(const CompareOptions& o) {
+  if (!o.tasks.empty()) {
+    return {{o.tasks, o.models.empty() ? tasks::model_names() : o.models,
+             o.losses.empty() ? std::vector<std::string>{"derivative"} : o.losses}};
+  }
+  std::vector<Group> groups;
+  for (Group g : default_study()) {
+    const auto keep = [](std::vector<std::string>& names, const std::vector<std::string>& only) {
+      if (only.empty()) return;
+      std::erase_if(names, [&](const std::string& n) { return !contains(only, n); });
+    };
+    keep(g.models, o.models);
+    keep(g.losses, o.losses);
+    if (!g.models.empty() && !g.losses.empty()) groups.push_back(g);
+  }
+  if (groups.empty())
+    throw std::invalid_argument("compare: the default study has no runs of those --models/--loss");
+  return groups;
+}
+
+// The sweep spec of one row: its task, model and loss, and the seeds (and steps) of the study.
+ordered_json row_spec(const Row& row, const CompareOptions& o) {
+  ordered_json spec = ordered_json::object();
+  spec["task"] = {row.task};
+  spec["model"] = {row.model};
+  ordered_json seeds = ordered_json::array();
+  for (int s = 0; s < o.seeds; ++s) seeds.push_back(static_cast<unsigned long long>(s));
+  spec["seed"] = seeds;
+  if (o.steps > 0) spec["steps"] = {o.steps};
+  if (row.loss != "derivative") spec["loss"] = {row.loss};  // derivative: hnn train's default
+  return spec;
+}
+
+// "compare: run 'x/y/seed=0': why" or "compare: key 'loss': why" -> the why, as hnn said it.
+std::string reason_of(std::string message) {
+  const std::string prefix = "compare: ";
+  if (message.rfind(prefix, 0) == 0) message.erase(0, prefix.size());
+  if (message.rfind("run '", 0) == 0) {
+    if (const auto end = message.find("': "); end != std::string::npos) message.erase(0, end + 3);
+  }
+  return message;
+}
+
+// Expands every row through the sweep's checks; the runs of those that pass make one plan.
+sweep::SweepPlan expand_rows(std::vector<Row>& rows, const CompareOptions& o, const fs::path& out) {
+  const std::vector<std::string> known_tasks = tasks::task_names(),
+                                 known_models = tasks::model_names();
+  sweep::SweepPlan plan;
+  std::set<std::string> keys, names;
+  for (Row& row : rows) {
+    if (!contains(known_tasks, row.task)) {
+      row.skipped = fmt::format("this hnn has no task '{}' yet (its tasks: {})", row.task,
+                                fmt::join(known_tasks, ", "));
+      continue;
+    }
+    if (!contains(known_models, row.model)) {
+      row.skipped = fmt::format("this hnn has no model '{}' yet (its models: {})", row.model,
+                                fmt::join(known_models, ", "));
+      continue;
+    }
+    sweep::SweepPlan one;
+    try {
+      one = sweep::expand(row_spec(row, o), "compare", out);
+    } catch (const std::invalid_argument& e) {
+      row.skipped = reason_of(e.what());
+      continue;
+    }
+    for (sweep::SweepRun& r : one.runs) {
+      row.runs.push_back(r.name);
+      if (names.insert(r.name).second) plan.runs.push_back(std::move(r));
+    }
+    keys.insert(one.keys.begin(), one.keys.end());
+  }
+  for (const sweep::KeyInfo& k : sweep::key_table())
+    if (keys.count(std::string(k.name))) plan.keys.emplace_back(k.name);
+  return plan;
+}
+
+std::vector<Row> rows_of(const std::vector<Group>& groups) {
+  std::vector<Row> rows;
+  std::set<std::string> seen;
+  for (const Group& g : groups)
+    for (const std::string& t : g.tasks)
+      for (const std::string& m : g.models)
+        for (const std::string& l : g.losses)
+          if (seen.insert(t + "\n" + m + "\n" + l).second) rows.push_back({t, m, l, "", {}});
+  return rows;
+}
+
+// ---- the peers' numbers ----------------------------------------------------------------------
+
+fs::path own_executable() { return fs::read_symlink("/proc/self/exe"); }
+
+// $HNN_PEERS, the installed share/hnn/peers.json, or the source tree's tasks/report/peers.json.
+fs::path peers_path() {
+  if (const char* env = std::getenv("HNN_PEERS")) return env;
+  const fs::path installed =
+      own_executable().parent_path().parent_path() / "share" / "hnn" / "peers.json";
+  if (fs::exists(installed)) return installed;
+  return HNN_PEERS_SOURCE;
+}
+
+// The peers file, checked entry by entry: one line naming the file and the entry otherwise.
+json read_peers(const fs::path& file) {
+  std::ifstream in(file);
+  const auto bad = [&](const std::string& what) {
+    return std::invalid_argument(fmt::format("peers file {}: {}", file.string(), what));
+  };
+  if (!in) throw bad("cannot be read (HNN_PEERS names another)");
+  const json doc = json::parse(in, nullptr, /*allow_exceptions=*/false);
+  if (!doc.is_object() || !doc.contains("peers") || !doc["peers"].is_array())
+    throw bad("expected an object with a \"peers\" list");
+  for (std::size_t i = 0; i < doc["peers"].size(); ++i) {
+    const json& p = doc["peers"][i];
+    const auto need = [&](const char* key, bool ok, const char* what) {
+      if (!ok) throw bad(fmt::format("entry {}: '{}' must be {}", i + 1, key, what));
+    };
+    need("peer", p.contains("peer") && p["peer"].is_string(), "a string");
+    need("source", p.contains("source") && p["source"].is_string(), "a string");
+    need("task", p.contains("task") && p["task"].is_string(), "a string");
+    need("peer_model", p.contains("peer_model") && p["peer_model"].is_string(), "a string");
+    need("value", p.contains("value") && p["value"].is_number(), "a number");
+    need("model", !p.contains("model") || p["model"].is_null() || p["model"].is_string(),
+         "an hnn model family or null");
+    need("metric", !p.contains("metric") || p["metric"].is_null() || p["metric"].is_string(),
+         "a metrics.json key or null");
+    need("se", !p.contains("se") || p["se"].is_null() || p["se"].is_number(), "a number");
+  }
+  return doc;
+}
+
+constexpr const char* kTable1Protocol =
+    "the HNN paper's settings (each task's defaults); train and test loss: MSE of dx/dt over the "
+    "split; energy: MSE of the true energy along true and learned rollouts";
+
+// The HNN paper's Table 1 for the study's paper tasks: Task::paper(), the numbers `hnn
+// reproduce` sets beside its own.
+json table1_peers(const std::vector<Row>& rows) {
+  json out = json::array();
+  const std::vector<std::string> paper_tasks = tasks::paper_task_names();
+  std::set<std::string> done;
+  for (const Row& row : rows) {
+    if (!contains(paper_tasks, row.task) || !done.insert(row.task).second) continue;
+    const auto task = tasks::make_task(row.task);
+    for (const nn::ModelKind model : {nn::ModelKind::kBaseline, nn::ModelKind::kHnn}) {
+      const tasks::PaperRow paper = task->paper(model);
+      const std::pair<const char*, tasks::PaperValue> values[] = {{"train_loss", paper.train_loss},
+                                                                  {"test_loss", paper.test_loss},
+                                                                  {"energy_mse", paper.energy_mse}};
+      for (const auto& [metric, v] : values) {
+        out.push_back({{"peer", "HNN (Greydanus et al. 2019)"},
+                       {"source", "the HNN paper's Table 1 (hnn: Task::paper() of tasks/" +
+                                      row.task + ", as hnn reproduce's table1.md)"},
+                       {"task", row.task},
+                       {"model", nn::to_string(model)},
+                       {"loss", "derivative"},
+                       {"peer_model", model == nn::ModelKind::kHnn ? "HNN" : "baseline MLP"},
+                       {"metric", metric},
+                       {"value", v.mean},
+                       {"se", v.se},
+                       {"n", "the paper's seeds"},
+                       {"protocol", kTable1Protocol}});
+      }
+    }
+  }
+  return out;
+}
+
+json rows_json(const std::vector<Row>& rows) {
+  json out = json::array();
+  for (const Row& r : rows) {
+    out.push_back({{"task", r.task},
+                   {"model", r.model},
+                   {"loss", r.loss},
+                   {"runs", r.runs},
+                   {"skipped", r.skipped.empty() ? json(nullptr) : json(r.skipped)}});
+  }
+  return out;
+}
+
+json compare_section(const std::vector<Row>& rows, const CompareOptions& o) {
+  const fs::path file = peers_path();
+  json peers_doc = read_peers(file);
+  json peers = table1_peers(rows);
+  for (const json& p : peers_doc["peers"]) peers.push_back(p);
+  return {{"command", o.command},
+          {"seeds", o.seeds},
+          {"steps", o.steps > 0 ? json(o.steps) : json("each task's default")},
+          {"peers_file", fs::absolute(file).lexically_normal().string()},
+          {"headline", peers_doc.value("headline", json::object())},
+          {"report_metrics", peers_doc.value("report_metrics", json::array({"test_loss"}))},
+          {"hnn_tasks", tasks::task_names()},
+          {"rows", rows_json(rows)},
+          {"peers", peers}};
+}
+
+void list_rows(const std::vector<Row>& rows) {
+  for (const Row& r : rows) {
+    if (r.skipped.empty())
+      fmt::print("{} {} {}: {} runs\n", r.task, r.model, r.loss, r.runs.size());
+    else
+      fmt::print("{} {} {}: skipped: {}\n", r.task, r.model, r.loss, r.skipped);
+  }
+}
+
+void run_compare(CompareOptions o) {
+  check_names(o.tasks, tasks::task_names(), "--tasks", "task");
+  check_names(o.models, tasks::model_names(), "--models", "model");
+  check_names(o.losses, loss_names(), "--loss", "loss");
+  sweep::check_scheduler(o.launch.scheduler);
+  if (o.quick && o.steps == 0) o.steps = kQuickSteps;
+  const fs::path out = fs::absolute(o.out).lexically_normal();
+  std::vector<Row> rows = rows_of(study(o));
+  const sweep::SweepPlan plan = expand_rows(rows, o, out);
+  const json section = compare_section(rows, o);  // the peers file is checked before any run
+  if (o.list) {
+    list_rows(rows);
+    return sweep::list_runs(plan, o.launch, out);
+  }
+  sweep::launch(plan, o.launch, out, o.command, "run", {{"compare", section}});
+}
+
+std::string command_line(int argc, char** argv) {
+  std::string line = "hnn";
+  for (int i = 1; i < argc; ++i) line += " " + sweep::shell_quote(argv[i]);
+  return line;
+}
+
+}  // namespace
+
+void add_compare_command(CLI::App& app, int argc, char** argv) {
+  auto* cmd = app.add_subcommand(
+      "compare",
+      "Train every model family on the study's tasks for N seeds (through hnn sweep's engine) "
+      "and table ours beside the peers' published numbers; see docs/compare.md");
+  auto o = std::make_shared<CompareOptions>();
+  o->command = command_line(argc, argv);
+  cmd->add_option("--tasks", o->tasks,
+                  "Comma-separated tasks (default: the study of docs/compare.md)")
+      ->delimiter(',');
+  cmd->add_option("--models", o->models,
+                  "Comma-separated model families (default: every one hnn has)")
+      ->delimiter(',');
+  cmd->add_option("--loss", o->losses, "Comma-separated losses: derivative, rollout")
+      ->delimiter(',');
+  cmd->add_option("--seeds", o->seeds, "Seeds per task, model and loss (0..N-1)")
+      ->check(integer_in(1, 1000))
+      ->capture_default_str();
+  cmd->add_option("--steps", o->steps, "Training steps of every run (default: each task's)")
+      ->check(positive_integer());
+  cmd->add_flag("--quick", o->quick,
+                fmt::format("A smoke run: {} steps a run unless --steps", kQuickSteps));
+  cmd->add_option("--out", o->out, "Folder: runs/, results.csv, compare.md/.json, the chart")
+      ->required();
+  cmd->add_option("--scheduler", o->launch.scheduler,
+                  "A running Dask scheduler, tcp://HOST:PORT, whose workers share --out "
+                  "(default: a local cluster)");
+  cmd->add_option("--workers", o->launch.workers,
+                  "Local cluster's workers (default: the cores / --threads-per-run)")
+      ->check(integer_in(1, 1024));
+  cmd->add_option("--threads-per-run", o->launch.threads_per_run,
+                  "hnn train --threads of every run")
+      ->check(integer_in(1, 256))
+      ->capture_default_str();
+  cmd->add_flag("--retry-failed", o->launch.retry_failed,
+                "Run again the runs that failed for their own reasons");
+  cmd->add_flag("--list", o->list,
+                "Print each task, model and loss (its runs, or why it is skipped) and each run's "
+                "hnn train command; run nothing");
+  cmd->callback([o] { run_compare(*o); });
+}
+
+}  // namespace hnn::app

@@ -1,0 +1,38 @@
+#pragma once
+// Running a checked plan of runs through the sweep engine: the folder's lock, the program's copy,
+// DIR/plan.json, then the Python driver (apps/hnn/sweep_driver.py). Shared by `hnn sweep` and
+// `hnn compare` (which adds its report to the plan).
+
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "apps/hnn/sweep_spec.h"
+
+namespace hnn::app::sweep {
+
+/// How the plan runs; the options of `hnn sweep` that are not the spec.
+struct LaunchOptions {
+  std::string scheduler;  // "": a local cluster
+  int workers = 0;        // 0: one per threads_per_run cores
+  int threads_per_run = 1;
+  bool retry_failed = false;
+};
+
+/// `text` as one shell word.
+std::string shell_quote(const std::string& text);
+
+/// Prints each run's `hnn train` command, as the driver would run it; writes nothing.
+void list_runs(const SweepPlan& plan, const LaunchOptions& o, const std::filesystem::path& out);
+
+/// Throws std::invalid_argument unless `scheduler` is empty or an address like tcp://HOST:8786.
+void check_scheduler(const std::string& scheduler);
+
+/// Creates `out`, takes its lock, copies this program and writes plan.json (the plan, `spec` as
+/// its source, and `extra`'s keys beside them), then becomes the driver in `mode` (run, collect,
+/// emit-slurm). Returns only by throwing.
+[[noreturn]] void launch(const SweepPlan& plan, const LaunchOptions& o,
+                         const std::filesystem::path& out, const std::string& spec,
+                         const std::string& mode, const nlohmann::json& extra = {});
+
+}  // namespace hnn::app::sweep

@@ -1,0 +1,186 @@
+#!/usr/bin/python3
+"""Tests of `hnn compare` (issue 18, section 5), run by ctest as compare.<Case> with HNN_EXE and
+HNN_SOURCE_DIR in the environment:  /usr/bin/python3 tests/sweep/compare_test.py -v Tiny
+
+Tiny runs a real comparison on a local Dask cluster (2 tasks, 3 models, 2 seeds, 30 steps) and
+checks its table against the runs' own metrics.json files and the peers file; Options checks bad
+options and the skip reasons of --list, which runs nothing."""
+
+import json
+import math
+import os
+import re
+import shutil
+import subprocess
+import tempfile
+import unittest
+
+HNN = os.environ.get("HNN_EXE", "build/apps/hnn")
+SOURCE = os.environ.get("HNN_SOURCE_DIR", os.getcwd())
+PEERS = os.path.join(SOURCE, "tasks", "report", "peers.json")
+
+
+def hnn(*args):
+    return subprocess.run([HNN, *args], capture_output=True, text=True, timeout=600)
+
+
+def read_json(path):
+    with open(path) as f:
+        return json.load(f)
+
+
+def read_text(path):
+    with open(path) as f:
+        return f.read()
+
+
+def mean_se(values):
+    m = sum(values) / len(values)
+    return m, math.sqrt(sum((v - m) ** 2 for v in values) / (len(values) - 1) / len(values))
+
+
+class CompareCase(unittest.TestCase):
+    def setUp(self):
+        self.dir = tempfile.mkdtemp(prefix="hnn-compare-test-")
+        self.out = os.path.join(self.dir, "cmp")
+
+    def tearDown(self):
+        shutil.rmtree(self.dir, ignore_errors=True)
+
+    def assert_one_line_error(self, result, *needles):
+        self.assertEqual(result.returncode, 1, result.stderr)
+        lines = result.stderr.splitlines()
+        self.assertEqual(len(lines), 1, result.stderr)
+        self.assertTrue(lines[0].startswith("hnn: error: "), lines[0])
+        for needle in needles:
+            self.assertIn(needle, lines[0])
+
+
+class Options(CompareCase):
+    def test_bad_options_are_one_line_and_nothing_is_written(self):
+        cases = [
+            (["--tasks", "spring", "--models", "hnn,mlp"], ["unknown model 'mlp'", "known: hnn, baseline"]),
+            (["--tasks", "spring,sprung"], ["unknown task 'sprung'", "spring, pendulum"]),
+            (["--tasks", "spring", "--seeds", "0"], ["--seeds", "expected an integer from 1"]),
+            (["--tasks", "spring", "--loss", "energy"], ["unknown loss 'energy'", "derivative"]),
+            (["--tasks", "spring", "--steps", "0"], ["--steps", "expected an integer >= 1"]),
+            (["--tasks", "spring", "--scheduler", "localhost"], ["tcp://HOST:8786"]),
+        ]
+        for args, needles in cases:
+            with self.subTest(args=args):
+                self.assert_one_line_error(hnn("compare", *args, "--out", self.out), *needles)
+                self.assertFalse(os.path.exists(self.out))
+
+    def test_a_bad_peers_file_is_one_line(self):
+        bad = os.path.join(self.dir, "peers.json")
+        with open(bad, "w") as f:
+            json.dump({"peers": [{"peer": "x", "source": "y", "task": "spring"}]}, f)
+        result = subprocess.run([HNN, "compare", "--tasks", "spring", "--out", self.out],
+                                capture_output=True, text=True, env={**os.environ, "HNN_PEERS": bad})
+        self.assert_one_line_error(result, f"peers file {bad}: entry 1: 'peer_model' must be")
+        self.assertFalse(os.path.exists(self.out))
+
+    def test_list_gives_each_skip_hnn_s_own_reason_and_runs_nothing(self):
+        result = hnn("compare", "--tasks", "pixel-pendulum,spring", "--models", "dhnn,hnn",
+                     "--loss", "derivative,rollout", "--seeds", "2", "--list", "--out", self.out)
+        self.assertEqual(result.returncode, 0, result.stderr)
+        lines = result.stdout.splitlines()
+        # The reason is the one `hnn train` and `hnn sweep` give for that run.
+        train = hnn("train", "pixel-pendulum", "--model", "dhnn", "--out",
+                    os.path.join(self.dir, "x"))
+        reason = train.stderr.strip().replace("hnn: error: ", "")
+        self.assertIn(f"pixel-pendulum dhnn derivative: skipped: {reason}", lines)
+        self.assertIn("spring hnn derivative: 2 runs", lines)
+        self.assertIn("spring dhnn derivative: 2 runs", lines)
+        rollout = [l for l in lines if l.startswith("spring hnn rollout: ")]
+        self.assertEqual(len(rollout), 1)
+        if "skipped" in rollout[0]:  # the rollout loss on a task that lacks it, in hnn's words
+            train = hnn("train", "spring", "--loss", "rollout", "--out", os.path.join(self.dir, "y"))
+            self.assertIn(rollout[0].split("skipped: ")[1].split(":")[-1].strip(), train.stderr)
+        commands = [l for l in lines if l.startswith("hnn train ")]
+        runs = sum(int(l.split(": ")[1].split()[0]) for l in lines if l.endswith(" runs"))
+        self.assertEqual(len(commands), runs)
+        self.assertGreaterEqual(runs, 6)  # pixel-pendulum hnn, spring dhnn and hnn: 2 seeds each
+        self.assertFalse(os.path.exists(self.out))
+
+    def test_the_default_study_says_why_a_family_hnn_lacks_is_skipped(self):
+        result = hnn("compare", "--quick", "--list", "--out", self.out)
+        self.assertEqual(result.returncode, 0, result.stderr)
+        lines = result.stdout.splitlines()
+        self.assertIn("real-pendulum dhnn derivative: 3 runs", lines)
+        self.assertIn("damped-spring baseline derivative: 3 runs", lines)
+        lnn = [l for l in lines if l.startswith("double-pendulum lnn derivative: ")]
+        self.assertEqual(len(lnn), 1)
+        models = hnn("train", "--help").stdout
+        if "lnn" not in models:
+            self.assertIn("skipped: this hnn has no", lnn[0])
+        self.assertTrue(all("--steps 100" in l for l in lines if l.startswith("hnn train ")))
+
+
+class Tiny(CompareCase):
+    ARGS = ["--tasks", "damped-spring,spring", "--models", "baseline,dhnn,hnn",
+            "--seeds", "2", "--steps", "30", "--workers", "2"]
+
+    def test_a_tiny_comparison_tables_the_runs_beside_the_peers_and_reuses_them(self):
+        result = hnn("compare", *self.ARGS, "--out", self.out)
+        self.assertEqual(result.returncode, 0, result.stdout + result.stderr)
+        doc = read_json(os.path.join(self.out, "compare.json"))
+        md = read_text(os.path.join(self.out, "compare.md"))
+        self.assertTrue(os.path.getsize(os.path.join(self.out, "accuracy_vs_time.png")) > 1000)
+        self.assertEqual(len(doc["rows"]), 6)
+        peers = read_json(PEERS)["peers"]
+        for row in doc["rows"]:
+            self.assertEqual(row["status"], "done", row)
+            self.assertEqual(len(row["runs"]), 2)
+            metrics = [read_json(os.path.join(self.out, "runs", r, "metrics.json"))
+                       for r in row["runs"]]
+            self.assertEqual(sorted(m["seed"] for m in metrics), [0, 1])
+            self.assertTrue(all(m["steps"] == 30 for m in metrics))
+            for key in ("test_loss", "energy_mse", "state_mse", "train_seconds"):
+                mean, se = mean_se([m[key] for m in metrics])
+                got = row["metrics"][key]
+                self.assertAlmostEqual(got["mean"], mean, delta=1e-12 * abs(mean))
+                self.assertAlmostEqual(got["se"], se, delta=1e-12 * abs(se) + 1e-300)
+                # and in the markdown, as printed
+                line = f"| {key} | {mean:.3e} ± {se:.1e} |"
+                self.assertIn(line, md)
+            # the peers' numbers on this row: exactly the peers file's for its task and model
+            want = {(p["metric"], p["value"]) for p in peers
+                    if p["task"] == row["task"] and p.get("model") == row["model"]
+                    and (p.get("loss") or "derivative") == row["loss"]}
+            got = {(l["peer"].get("metric"), l["peer"]["value"]) for l in row["lines"]
+                   if l["peer"] and not l["peer"]["source"].startswith("the HNN paper")}
+            self.assertEqual(got, want, row["task"] + " " + row["model"])
+        # damped spring: the D-HNN paper's state MSE beside ours, on the same line
+        dhnn_state = next(p for p in peers if p["task"] == "damped-spring"
+                          and p.get("model") == "dhnn" and p["metric"] == "state_mse")
+        self.assertRegex(md, r"\| damped-spring \| dhnn \| derivative \| state_mse \| [0-9.e+-]+ ± "
+                         + r"[0-9.e+-]+ \| 2/2 \| " + re.escape(f"{dhnn_state['value']:.3e}"))
+        # spring: the HNN paper's Table 1 (Task::paper) beside ours
+        self.assertIn("| 3.842e-04 ± 6.5e-05 | HNN (Greydanus et al. 2019): HNN", md)
+
+        # The second invocation trains nothing and writes the same table.
+        again = hnn("compare", *self.ARGS, "--out", self.out)
+        self.assertEqual(again.returncode, 0, again.stderr)
+        self.assertIn("all 12 runs are finished", again.stdout)
+        self.assertEqual(read_json(os.path.join(self.out, "compare.json"))["rows"], doc["rows"])
+
+    def test_a_skipped_pair_is_a_row_with_its_reason(self):
+        # pixel-pendulum and dhnn: skipped by hnn's own check; its hnn runs would be too slow
+        # here, so only the skipped row and one cheap task run.
+        result = hnn("compare", "--tasks", "spring,pixel-pendulum", "--models", "dhnn",
+                     "--seeds", "1", "--steps", "5", "--workers", "1", "--out", self.out)
+        self.assertEqual(result.returncode, 0, result.stdout + result.stderr)
+        doc = read_json(os.path.join(self.out, "compare.json"))
+        skipped = [r for r in doc["rows"] if r["status"] == "skipped"]
+        self.assertEqual([(r["task"], r["model"]) for r in skipped], [("pixel-pendulum", "dhnn")])
+        self.assertIn("does not train a dhnn model", skipped[0]["skipped"])
+        md = read_text(os.path.join(self.out, "compare.md"))
+        self.assertIn(f"| pixel-pendulum | dhnn | derivative | skipped: {skipped[0]['skipped']} |",
+                      md)
+        results = read_json(os.path.join(self.out, "results.json"))
+        self.assertEqual([r["run"] for r in results["runs"]], ["spring/dhnn/seed=0,steps=5"])
+
+
+if __name__ == "__main__":
+    unittest.main()
