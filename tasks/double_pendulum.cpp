@@ -5,18 +5,20 @@
 // velocities U[0, 0.1)), 29.4 = 3 g being the scale of the potential. An HNN needs canonical
 // momenta, which these coordinates are not: the task trains an LNN or a baseline.
 
+#include <algorithm>
 #include <cmath>
 
 #include "physics/double_pendulum.h"
 #include "tasks/experiments.h"
 #include "tasks/field_task.h"
+#include "tasks/error.h"
 #include "tasks/report/json_values.h"
 
 namespace hnn::tasks {
 
 namespace {
 
-constexpr int kTrain = 20000, kTest = 5000;
+constexpr int kTrain = 20000, kTest = 5000, kMaxRollouts = 1000;
 constexpr double kMaxSpeed = 10.0, kEnergyScale = 29.4;
 
 class DoublePendulumTask : public FieldTask {
@@ -50,10 +52,30 @@ class DoublePendulumTask : public FieldTask {
   }
   const physics::System& truth() const override { return pendulum_; }
   Batch rollout_states(const Dataset&, std::mt19937_64& rng) const override {
-    return pendulum_.sample_initial_states(rollout_config().trajectories, rng);
+    return pendulum_.sample_initial_states(kMaxRollouts, rng);  // the run keeps the first N
   }
+  // 100 trajectories to T = 100 (the LNN paper used 40), sampled at 10 per unit of time.
   RolloutConfig rollout_config() const override {
     return {.trajectories = 100, .t_end = 100.0, .points = 1001, .rtol = 1e-9, .atol = 1e-11};
+  }
+  // Settings "rollouts" (1..1000) and "t_end" (> 0): fewer or shorter for quick runs.
+  RolloutConfig rollout_config(const nlohmann::json& s) const override {
+    RolloutConfig c = rollout_config();
+    c.trajectories = json_integer<int>(s.value("rollouts", nlohmann::json(c.trajectories)), "rollouts");
+    c.t_end = s.value("t_end", c.t_end);
+    c.points = std::max(2, int(std::lround(c.t_end * 10)) + 1);
+    return c;
+  }
+  void check_task_settings(const nlohmann::json& s) const override {
+    for (const auto& [key, value] : s.items())
+      HNN_TASKS_CHECK(key == "rollouts" || key == "t_end",
+                      "double-pendulum has no setting '{}' (known: rollouts, t_end)", key);
+    const RolloutConfig c = rollout_config(s);
+    HNN_TASKS_CHECK(c.trajectories >= 1 && c.trajectories <= kMaxRollouts,
+                    "double-pendulum: rollouts must be in 1..{}, got {}", kMaxRollouts,
+                    c.trajectories);
+    HNN_TASKS_CHECK(std::isfinite(c.t_end) && c.t_end > 0,
+                    "double-pendulum: t_end must be a positive number, got {}", c.t_end);
   }
   void add_metrics(const Rollouts& r, nlohmann::json& metrics) const override {
     const nn::MeanStderr e = energy_error_at_end(r, kEnergyScale);

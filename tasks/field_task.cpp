@@ -20,7 +20,7 @@ class FieldRun : public FieldModelRun {
         task_(task) {}
 
   nlohmann::json evaluate(const RunFolder* folder) const override {
-    const RolloutConfig config = task_.rollout_config();
+    const RolloutConfig config = task_.rollout_config(s_.task_settings);
     FieldEvaluation e = evaluate_field_model(task_.truth(), dynamics(), data_,
                                              rollout_states(config.trajectories), config);
     task_.add_metrics(e.rollouts, e.metrics);
@@ -44,7 +44,7 @@ class FieldRun : public FieldModelRun {
     return x0;
   }
 
-  double rollout_span() const override { return task_.rollout_config().t_end; }
+  double rollout_span() const override { return task_.rollout_config(s_.task_settings).t_end; }
 
  private:
   const FieldTask& task_;
@@ -53,6 +53,8 @@ class FieldRun : public FieldModelRun {
 }  // namespace
 
 void FieldTask::add_metrics(const Rollouts&, nlohmann::json&) const {}
+
+RolloutConfig FieldTask::rollout_config(const nlohmann::json&) const { return rollout_config(); }
 
 std::unique_ptr<TaskRun> FieldTask::open(const RunSettings& settings) const {
   return std::make_unique<FieldRun>(*this, settings);

@@ -26,6 +26,8 @@ class FieldTask : public Task {
   /// Initial states of the energy-metric rollouts.
   virtual Batch rollout_states(const Dataset& data, std::mt19937_64& rng) const = 0;
   virtual RolloutConfig rollout_config() const { return {}; }
+  /// The rollouts of a run with these task settings (a task may let them change the count).
+  virtual RolloutConfig rollout_config(const nlohmann::json& settings) const;
   /// Metrics of the task's own protocol from the evaluation's rollouts (a peer's), added to
   /// metrics.json; by default none.
   virtual void add_metrics(const Rollouts& rollouts, nlohmann::json& metrics) const;

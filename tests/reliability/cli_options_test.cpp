@@ -26,7 +26,7 @@ std::vector<BadOption> bad_train_options() {
       {{"train", "spring", "--batch", "751", "--hidden", "8"},
        "--batch 751 is larger than the training set (750 rows)"},
       {{"train", "spring", "--model", "transformer"},
-       "--model: transformer not in {hnn,baseline,dhnn}"},
+       "--model: transformer not in {hnn,baseline,dhnn,lnn}"},
       {{"train", "pixel-pendulum", "--model", "dhnn"},
        "task 'pixel-pendulum' does not train a dhnn model (its models: hnn, baseline)"},
       {{"train", "spring", "--dtype", "half"}, "--dtype: half not in {float,double}"},
@@ -142,7 +142,7 @@ TEST(CliOptions, BadCommandsAndOtherSubcommandsGetOneLine) {
        "Could not convert: --no-reversibility = x"},
       {{"reproduce", "--tasks", "spring,nope", "--out", (dir / "results").string()},
        "unknown task 'nope' (known: spring, pendulum, real-pendulum, two-body, three-body, "
-       "pixel-pendulum, damped-spring, data)"},
+       "pixel-pendulum, damped-spring, double-pendulum, data)"},
       {{"reproduce", "--tasks", "data", "--out", (dir / "results").string()},
        "reproduce runs the paper's tasks (spring, pendulum, real-pendulum, two-body, three-body, "
        "pixel-pendulum); 'data' is not one of them: train it with hnn train data"},
