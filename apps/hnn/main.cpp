@@ -71,7 +71,7 @@ tasks::RunOptions resumed_options(const CLI::App& cmd, const std::string& dir, b
         "--preset",      "--batch", "--hidden",     "--lr",        "--data",
         "--settings",    "--out",   "--coords",     "--momenta",   "--velocities",
         "--derivatives", "--time",  "--trajectory", "--split",     "--test-fraction",
-        "--hamiltonian", "--loss",  "--horizon",    "--integrator"}) {
+        "--hamiltonian", "--loss",  "--horizon",    "--integrator", "--dt"}) {
     if (cmd.get_option(name)->count() > 0) {
       throw std::invalid_argument(fmt::format(
           "{} cannot be combined with --resume: a resumed run keeps its own settings", name));
