@@ -167,6 +167,14 @@ class FieldRun : public FieldModelRun {
                                   std::ptrdiff_t(std::min(kMaxStretches, stretches_->test.size())));
     const int per_body = task_.coordinates_per_body();
     json m = stretch_errors("stretch_", test, predict_paths(test, model_predictor()), per_body);
+    // The same on training stretches: the gap to the test figure is what generalisation costs.
+    std::vector<Stretch> train(stretches_->train.begin(),
+                               stretches_->train.begin() +
+                                   std::ptrdiff_t(std::min(kMaxStretches, stretches_->train.size())));
+    const json fit = stretch_errors("train_stretch_", train, predict_paths(train, model_predictor()),
+                                    per_body);
+    m["train_stretch_position_error"] = fit["train_stretch_position_error"];
+    m["train_stretch_state_mse"] = fit["train_stretch_state_mse"];
     m["stretch_predictor"] = loss_.rollout ? fmt::format("{}, {} step(s) per interval",
                                                          to_string(loss_.integrator), substeps_)
                                            : std::string("dopri5 (rtol 1e-9)");

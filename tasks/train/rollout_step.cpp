@@ -165,6 +165,7 @@ Matrix<T> midpoint_solve(const nn::DynamicsModel<T>& model, const Matrix<T>& x0,
   Matrix<T> x1 = step(model.field(x0));  // explicit Euler: the first guess
   double previous = std::numeric_limits<double>::infinity();
   bool newton = false;
+  std::vector<Matrix<T>> inv;  // A^-1 of the chord iterations, refreshed when they slow down
   std::pair<double, Eigen::Index> worst{0, 0};
   for (int it = 0; it <= solve.max_iterations; ++it) {
     const Matrix<T> m = (x0 + x1) * T(0.5);
@@ -174,11 +175,14 @@ Matrix<T> midpoint_solve(const nn::DynamicsModel<T>& model, const Matrix<T>& x0,
     if (worst.first <= double(tolerance)) return x1;
     if (std::isnan(worst.first) || it == solve.max_iterations) break;
     ++t_midpoint_iterations;
-    // Fixed-point iteration while it contracts fast; Newton once it does not (h L / 2 near 1).
-    if (!newton && it > 0 && worst.first > 0.25 * previous) newton = true;
+    // Fixed-point iteration while it contracts fast; then Newton's chord method (the Jacobian
+    // kept while the residual falls at least fourfold per iteration: a Jacobian costs one
+    // backward sweep per state column, a chord iteration one field call).
+    const double ratio = worst.first / previous;
+    if (!newton && it > 0 && ratio > 0.25) newton = true;
     if (newton) {
-      const std::vector<Matrix<T>> inv =
-          inverse_columns<T>(field_row_jacobian(model, m), h, x0.cols());
+      if (inv.empty() || ratio > 0.25)
+        inv = inverse_columns<T>(field_row_jacobian(model, m), h, x0.cols());
       for (Eigen::Index j = 0; j < x0.cols(); ++j)
         x1 -= (inv[std::size_t(j)].array().colwise() * residual.col(j).array()).matrix();
     } else {
