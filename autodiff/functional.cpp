@@ -14,9 +14,8 @@ Matrix<T> gradient_of_element(const Var<T>& y, const Var<T>& x, Eigen::Index ind
   Matrix<T> seed = Matrix<T>::Zero(y.rows(), y.cols());
   seed.data()[index] = T(1);
   if (!y.requires_grad()) return Matrix<T>::Zero(1, x.rows() * x.cols());
-  const Var<T> g =
-      grad<T>({y}, {x}, GradOptions{.create_graph = false, .allow_unused = true},
-              {Var<T>::constant(seed)})[0];
+  const Var<T> g = grad<T>({y}, {x}, GradOptions{.create_graph = false, .allow_unused = true},
+                           {Var<T>::constant(seed)})[0];
   return g.value().template reshaped<Eigen::RowMajor>().transpose();
 }
 
@@ -27,7 +26,50 @@ Matrix<T> jacobian_of(const Var<T>& y, const Var<T>& x) {
   return jac;
 }
 
+// Ones in column `column` of a rows x cols tape node, zeros elsewhere: the seed of one reverse
+// pass of row_jacobian, filled in place in a recycled node (no temporary matrix).
+template <typename T>
+Var<T> column_seed(Eigen::Index rows, Eigen::Index cols, Eigen::Index column) {
+  Node<T>& node = Tape<T>::current().push();
+  node.op = "row_jacobian_seed";
+  node.value.setZero(rows, cols);
+  node.value.col(column).setOnes();
+  return Var<T>::of(node);
+}
+
+template <typename T>
+Var<T> zeros(Eigen::Index rows, Eigen::Index cols) {
+  Node<T>& node = Tape<T>::current().push();
+  node.op = "zeros";
+  node.value.setZero(rows, cols);
+  return Var<T>::of(node);
+}
+
 }  // namespace
+
+template <typename T>
+Var<T> row_jacobian(const Var<T>& y, const Var<T>& x, const GradOptions& options) {
+  HNN_AD_CHECK(y.rows() == x.rows(), "row_jacobian: y {} and x {} have different row counts",
+               y.shape(), x.shape());
+  HNN_AD_CHECK(y.cols() > 0, "row_jacobian: y {} has no columns", y.shape());
+  if (!y.requires_grad() && options.allow_unused) return zeros<T>(x.rows(), y.cols() * x.cols());
+  std::vector<Var<T>> blocks;  // block j: d y[:, j] / d x, R x n
+  blocks.reserve(std::size_t(y.cols()));
+  for (Eigen::Index j = 0; j < y.cols(); ++j)
+    blocks.push_back(grad<T>({y}, {x}, options, {column_seed<T>(y.rows(), y.cols(), j)})[0]);
+  return concat_cols(blocks);
+}
+
+template <typename T>
+Var<T> row_hessian(const Var<T>& l, const Var<T>& x, const GradOptions& options) {
+  HNN_AD_CHECK(l.cols() == 1 && l.rows() == x.rows(),
+               "row_hessian: l must be one scalar per row of x {}, got {}", x.shape(), l.shape());
+  const Var<T> gradient =
+      grad<T>({l}, {x}, GradOptions{.create_graph = true, .allow_unused = options.allow_unused})[0];
+  // A gradient that is constant in x (l linear in x) has a zero Hessian, not an error.
+  return row_jacobian(gradient, x,
+                      GradOptions{.create_graph = options.create_graph, .allow_unused = true});
+}
 
 template <typename T>
 Matrix<T> jacobian(const VarFunction<T>& f, const Matrix<T>& x) {
@@ -59,10 +101,12 @@ Matrix<T> hvp(const VarFunction<T>& f, const Matrix<T>& x, const Matrix<T>& v) {
   return grad<T>({g}, {xv}, GradOptions{.allow_unused = true}, {Var<T>::constant(v)})[0].value();
 }
 
-#define HNN_INSTANTIATE(T)                                                        \
-  template Matrix<T> jacobian(const VarFunction<T>&, const Matrix<T>&);           \
-  template Matrix<T> hessian(const VarFunction<T>&, const Matrix<T>&);            \
-  template Matrix<T> hvp(const VarFunction<T>&, const Matrix<T>&, const Matrix<T>&);
+#define HNN_INSTANTIATE(T)                                                           \
+  template Matrix<T> jacobian(const VarFunction<T>&, const Matrix<T>&);              \
+  template Matrix<T> hessian(const VarFunction<T>&, const Matrix<T>&);               \
+  template Matrix<T> hvp(const VarFunction<T>&, const Matrix<T>&, const Matrix<T>&); \
+  template Var<T> row_jacobian(const Var<T>&, const Var<T>&, const GradOptions&);    \
+  template Var<T> row_hessian(const Var<T>&, const Var<T>&, const GradOptions&);
 HNN_INSTANTIATE(float)
 HNN_INSTANTIATE(double)
 #undef HNN_INSTANTIATE

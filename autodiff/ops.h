@@ -6,6 +6,7 @@
 // one value per feature, repeated over the batch), a column (Rx1), or a scalar (1x1). The
 // gradient of a broadcast operand is summed back to its shape (sum_to).
 
+#include <limits>
 #include <type_traits>
 #include <vector>
 
@@ -53,6 +54,37 @@ template <typename T> Var<T> transpose(const Var<T>& a);
 /// Fused layer x W + b (b a 1xC row, optional: pass an empty Var). d/dx = g W^T,
 /// d/dW = x^T g, d/db = sum_rows g.
 template <typename T> Var<T> linear(const Var<T>& x, const Var<T>& w, const Var<T>& b = {});
+
+// ---- batched small linear algebra: one block per row of the batch -------------------------
+// Row r of `a` holds a small matrix A_r flattened row-major (n x n: R x n^2), row r of a vector
+// operand holds v_r. These are the per-sample Hessian blocks of a Lagrangian network.
+
+/// batched_solve refuses a block whose reciprocal condition number 1 / (|A|_1 |A^-1|_1) is below
+/// this (exact for blocks up to 4x4, Eigen's estimate above): 1000 epsilons, 2.2e-13 in double and 1.2e-4 in float. There the solution has
+/// no correct digits left (relative error ~ eps / rcond), so a NaN-free result would be a lie.
+template <typename T>
+inline constexpr T kBatchedSolveMinRcond = T(1000) * std::numeric_limits<T>::epsilon();
+
+/// X (R x n) with A_r x_r = b_r, or A_r^T x_r = b_r with transpose_a; b is R x n, a is R x n^2.
+/// Partial-pivot LU per row. Derivatives: d/db = batched_solve(a, g, !transpose_a), the
+/// adjoint solve gb; d/da = -batched_outer(gb, x) (-batched_outer(x, gb) with transpose_a).
+/// Throws hnn::ad::Error naming the row of a block that is singular, ill-conditioned
+/// (kBatchedSolveMinRcond) or not finite, or of a non-finite right-hand side.
+template <typename T>
+Var<T> batched_solve(const Var<T>& a, const Var<T>& b, bool transpose_a = false);
+
+/// op(A_r) v_r per row, v R x n. a is R x (k n): A_r is k x n, or n x k used transposed (k = n,
+/// the square case, in the Lagrangian network; rectangular blocks are the gradient of
+/// batched_outer). Derivatives: d/dv = batched_matvec(a, g, !transpose_a); d/da =
+/// batched_outer(g, v) (batched_outer(v, g) with transpose_a).
+template <typename T>
+Var<T> batched_matvec(const Var<T>& a, const Var<T>& v, bool transpose_a = false);
+
+/// u_r v_r^T per row, flattened row-major: R x n and R x m -> R x (n m). Derivatives (G_r the
+/// n x m gradient block): d/du = batched_matvec(g, v) = G_r v_r, d/dv = batched_matvec(g, u,
+/// true) = G_r^T u_r.
+template <typename T>
+Var<T> batched_outer(const Var<T>& u, const Var<T>& v);
 
 // ---- reductions and shapes -------------------------------------------------------------------
 template <typename T> Var<T> sum(const Var<T>& a);       // -> 1x1

@@ -2,7 +2,8 @@
 // backward of a 2-W-W-1 tanh MLP) in float and double, and the gradient of a known Hamiltonian
 // by autodiff, by central finite differences over a sweep of steps h, and analytically, with
 // each method's error against the analytic gradient. Run with --benchmark_format=json for the
-// speed-against-accuracy charts.
+// speed-against-accuracy charts. Then the Lagrangian network's ops: batched_solve forward and
+// backward, and the per-row Hessians of an MLP by row_hessian.
 
 #include <benchmark/benchmark.h>
 
@@ -227,6 +228,66 @@ HNN_GRAD_H_BENCHMARKS(double, Pendulum)
 HNN_GRAD_H_BENCHMARKS(float, TwoBody)
 HNN_GRAD_H_BENCHMARKS(double, TwoBody)
 #undef HNN_GRAD_H_BENCHMARKS
+
+// ---- 3. the Lagrangian network's ops ---------------------------------------------------------
+
+// Args: rows R, block size n. One iteration: x = batched_solve(A, b) over R diagonally dominant
+// n x n blocks, and the gradient of sum(x^2) with respect to A and b (the adjoint solve and the
+// outer product), in a reused TapeScope.
+template <typename T>
+void BM_BatchedSolve(benchmark::State& state) {
+  const Eigen::Index rows = state.range(0), n = state.range(1);
+  Matrix<double> a = Uniform(rows, n * n, 30, -0.5, 0.5);
+  for (Eigen::Index r = 0; r < rows; ++r)
+    for (Eigen::Index i = 0; i < n; ++i) a(r, i * n + i) += 2.0;
+  const std::vector<Var<T>> inputs = {Var<T>::leaf(a.cast<T>()),
+                                      Var<T>::leaf(Uniform(rows, n, 31, -1, 1).cast<T>())};
+  std::vector<Var<T>> grads;
+  for (auto _ : state) {
+    ad::TapeScope scope;
+    const Var<T> x = ad::batched_solve(inputs[0], inputs[1]);
+    ad::grad_into(ad::sum(ad::square(x)), inputs, grads);
+    benchmark::DoNotOptimize(grads.front().value().data());
+  }
+  state.SetItemsProcessed(state.iterations() * rows);
+}
+
+BENCHMARK_TEMPLATE(BM_BatchedSolve, double)
+    ->ArgNames({"rows", "n"})
+    ->Args({512, 2})
+    ->Args({512, 4})
+    ->Unit(benchmark::kMicrosecond);
+BENCHMARK_TEMPLATE(BM_BatchedSolve, float)
+    ->ArgNames({"rows", "n"})
+    ->Args({512, 2})
+    ->Args({512, 4})
+    ->Unit(benchmark::kMicrosecond);
+
+// Args: rows R. One iteration: the R per-row 4x4 Hessians of a 4-128-128-1 softplus MLP
+// (a gradient with create_graph, then 4 reverse passes over it), values only.
+template <typename T>
+void BM_RowHessian(benchmark::State& state) {
+  const Eigen::Index rows = state.range(0);
+  const std::vector<Eigen::Index> sizes = {4, 128, 128, 1};
+  std::vector<Var<T>> params;
+  for (std::size_t l = 0; l + 1 < sizes.size(); ++l) {
+    params.push_back(Var<T>::leaf(Orthogonal(sizes[l], sizes[l + 1], 40 + l).cast<T>()));
+    params.push_back(Var<T>::leaf(Uniform(1, sizes[l + 1], 50 + l, -0.1, 0.1).cast<T>()));
+  }
+  const Var<T> x = Var<T>::leaf(Uniform(rows, 4, 60, -1, 1).cast<T>());
+  for (auto _ : state) {
+    ad::TapeScope scope;
+    Var<T> h = x;
+    for (std::size_t l = 0; l + 2 < params.size(); l += 2)
+      h = ad::softplus(ad::linear(h, params[l], params[l + 1]));
+    const Var<T> blocks = ad::row_hessian(ad::linear(h, params[4], params[5]), x);
+    benchmark::DoNotOptimize(blocks.value().data());
+  }
+  state.SetItemsProcessed(state.iterations() * rows);
+}
+
+BENCHMARK_TEMPLATE(BM_RowHessian, double)->ArgName("rows")->Arg(512)->Unit(benchmark::kMillisecond);
+BENCHMARK_TEMPLATE(BM_RowHessian, float)->ArgName("rows")->Arg(512)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 
