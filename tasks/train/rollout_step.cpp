@@ -1,10 +1,10 @@
 #include "tasks/train/rollout_step.h"
 
-#include <Eigen/LU>
 #include <cmath>
 #include <limits>
 #include <type_traits>
 
+#include "autodiff/functional.h"
 #include "autodiff/grad.h"
 #include "autodiff/ops.h"
 #include "autodiff/tape.h"
@@ -66,20 +66,21 @@ std::pair<double, Eigen::Index> worst_residual(const Matrix<T>& r, const Matrix<
   return {worst, row};
 }
 
-// A_r = I - (h_r / 2) J_r per row, inverted: the constant of the Newton correction.
+// A_r = I - (h_r / 2) J_r per row, flattened row-major (R x d^2): the matrix of the Newton
+// correction.
 template <typename T>
-std::vector<Matrix<T>> inverse_columns(const Matrix<T>& jac, const Matrix<T>& h, Eigen::Index d) {
-  // columns[j](r, i) = (A_r^-1)(i, j): the Newton correction is sum_j columns[j] * F(:, j).
-  std::vector<Matrix<T>> columns(std::size_t(d), Matrix<T>(jac.rows(), d));
-  Matrix<T> a(d, d);
-  for (Eigen::Index r = 0; r < jac.rows(); ++r) {
-    for (Eigen::Index i = 0; i < d; ++i)
-      for (Eigen::Index j = 0; j < d; ++j)
-        a(i, j) = (i == j ? T(1) : T(0)) - T(0.5) * h(r, 0) * jac(r, i * d + j);
-    const Matrix<T> inv = a.partialPivLu().inverse();
-    for (Eigen::Index j = 0; j < d; ++j) columns[std::size_t(j)].row(r) = inv.col(j).transpose();
-  }
-  return columns;
+Matrix<T> newton_matrix(const Matrix<T>& jac, const Matrix<T>& h, Eigen::Index d) {
+  Matrix<T> a = (jac.array().colwise() * (T(-0.5) * h.col(0).array())).matrix();
+  for (Eigen::Index i = 0; i < d; ++i) a.col(i * d + i).array() += T(1);
+  return a;
+}
+
+// A_r^-1 b_r per row, as values.
+template <typename T>
+Matrix<T> solve_rows(const Matrix<T>& a, const Matrix<T>& b) {
+  ad::TapeScope scope;
+  ad::NoGradGuard values;
+  return ad::batched_solve(Var<T>::constant(a), Var<T>::constant(b)).value();
 }
 
 // Note [Midpoint on the tape]
@@ -97,15 +98,8 @@ Var<T> midpoint(const nn::DynamicsModel<T>& model, const Var<T>& x, const Var<T>
   const Var<T> x1c = Var<T>::constant(x1);
   const Var<T> m = (x + x1c) * T(0.5);
   const Var<T> residual = x1c - x - h * model.time_derivative(m);
-  const Eigen::Index d = x.cols();
-  const std::vector<Matrix<T>> inv =
-      inverse_columns<T>(field_row_jacobian(model, m.value()), h.value(), d);
-  Var<T> correction;
-  for (Eigen::Index j = 0; j < d; ++j) {
-    const Var<T> term = Var<T>::constant(inv[std::size_t(j)]) * ad::slice_cols(residual, j, 1);
-    correction = correction.defined() ? correction + term : term;
-  }
-  return x1c - correction;
+  const Matrix<T> a = newton_matrix<T>(field_row_jacobian(model, m.value()), h.value(), x.cols());
+  return x1c - ad::batched_solve(Var<T>::constant(a), residual);
 }
 
 }  // namespace
@@ -140,19 +134,8 @@ Matrix<T> field_row_jacobian(const nn::DynamicsModel<T>& model, const Matrix<T>&
   ad::TapeScope scope;
   ad::GradModeGuard recording(true);
   const Var<T> xv = Var<T>::leaf(x);
-  const Var<T> f = model.time_derivative(xv);
-  const Eigen::Index d = x.cols();
-  Matrix<T> jac(x.rows(), d * d);
-  Matrix<T> pick = Matrix<T>::Zero(x.rows(), d);
-  for (Eigen::Index i = 0; i < d; ++i) {
-    pick.col(i).setOnes();
-    // Rows are independent samples, so d(sum_r f_ri)/dx_r is row r's d f_ri / d x_r.
-    const Var<T> g =
-        ad::grad<T>({f}, {xv}, {.allow_unused = true}, {Var<T>::constant(pick)})[0];
-    jac.middleCols(i * d, d) = g.value();
-    pick.col(i).setZero();
-  }
-  return jac;
+  // Rows are independent samples: row r of f depends on row r of x only.
+  return ad::row_jacobian(model.time_derivative(xv), xv, {.allow_unused = true}).value();
 }
 
 template <typename T>
@@ -165,7 +148,7 @@ Matrix<T> midpoint_solve(const nn::DynamicsModel<T>& model, const Matrix<T>& x0,
   Matrix<T> x1 = step(model.field(x0));  // explicit Euler: the first guess
   double previous = std::numeric_limits<double>::infinity();
   bool newton = false;
-  std::vector<Matrix<T>> inv;  // A^-1 of the chord iterations, refreshed when they slow down
+  Matrix<T> a;  // A of the chord iterations, refreshed when they slow down
   std::pair<double, Eigen::Index> worst{0, 0};
   for (int it = 0; it <= solve.max_iterations; ++it) {
     const Matrix<T> m = (x0 + x1) * T(0.5);
@@ -181,10 +164,9 @@ Matrix<T> midpoint_solve(const nn::DynamicsModel<T>& model, const Matrix<T>& x0,
     const double ratio = worst.first / previous;
     if (!newton && it > 0 && ratio > 0.25) newton = true;
     if (newton) {
-      if (inv.empty() || ratio > 0.25)
-        inv = inverse_columns<T>(field_row_jacobian(model, m), h, x0.cols());
-      for (Eigen::Index j = 0; j < x0.cols(); ++j)
-        x1 -= (inv[std::size_t(j)].array().colwise() * residual.col(j).array()).matrix();
+      if (a.size() == 0 || ratio > 0.25)
+        a = newton_matrix<T>(field_row_jacobian(model, m), h, x0.cols());
+      x1 -= solve_rows<T>(a, residual);
     } else {
       x1 = next;
     }
