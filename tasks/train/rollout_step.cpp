@@ -21,6 +21,16 @@ using Var = ad::Var<T>;
 template <typename T>
 using Matrix = ad::Matrix<T>;
 
+// [q | p] through a reused parts vector: an initializer list would allocate one per call, and
+// a warmed-up training step allocates nothing.
+template <typename T>
+Var<T> join(const Var<T>& q, const Var<T>& p) {
+  thread_local std::vector<Var<T>> parts(2);
+  parts[0] = q;
+  parts[1] = p;
+  return ad::concat_cols(parts);
+}
+
 // Kick-drift-kick (the file header): three field calls, each on the whole state.
 template <typename T>
 Var<T> leapfrog(const nn::DynamicsModel<T>& model, const Var<T>& x, const Var<T>& h) {
@@ -28,11 +38,10 @@ Var<T> leapfrog(const nn::DynamicsModel<T>& model, const Var<T>& x, const Var<T>
   const Var<T> half = h * T(0.5);
   const Var<T> q = ad::slice_cols(x, 0, n);
   const Var<T> p_half = ad::slice_cols(x, n, n) + half * ad::slice_cols(model.time_derivative(x), n, n);
-  const Var<T> q1 =
-      q + h * ad::slice_cols(model.time_derivative(ad::concat_cols<T>({q, p_half})), 0, n);
+  const Var<T> q1 = q + h * ad::slice_cols(model.time_derivative(join(q, p_half)), 0, n);
   const Var<T> p1 =
-      p_half + half * ad::slice_cols(model.time_derivative(ad::concat_cols<T>({q1, p_half})), n, n);
-  return ad::concat_cols<T>({q1, p1});
+      p_half + half * ad::slice_cols(model.time_derivative(join(q1, p_half)), n, n);
+  return join(q1, p1);
 }
 
 template <typename T>
