@@ -105,9 +105,8 @@ void BM_RolloutStep(benchmark::State& state) {
   std::mt19937_64 rng(1);
   const auto model = nn::make_model<double>(nn::DynamicsConfig{}, rng);
   const auto method = hnn::tasks::RolloutIntegrator(state.range(0));
-  hnn::tasks::RolloutObjective<double> objective(*model,
-                                                 hnn::tasks::rollout_windows(stretches, 4), {},
-                                                 128, {.lr = 1e-3}, 2, method);
+  hnn::tasks::RolloutObjective<double> objective(*model, hnn::tasks::rollout_windows(stretches, 4),
+                                                 {}, 128, {.lr = 1e-3}, 2, method);
   nn::Adam<double> adam(model->parameters(), {.lr = 1e-3});
   std::vector<ad::Var<double>> grads;
   double loss = 0;

@@ -30,7 +30,7 @@ struct DataConfig {
   bool standardize = true;
   double threshold = 0.1;
   int energy_rollouts = 15;
-  double energy_t_end = 0;    ///< 0: the held-out stretches' median duration
+  double energy_t_end = 0;   ///< 0: the held-out stretches' median duration
   RolloutLossConfig loss{};  ///< dx/dt targets, or through an integrator
 };
 
@@ -38,7 +38,7 @@ const std::vector<std::string>& setting_names() {
   static const std::vector<std::string> names = {
       "coords",          "momenta",       "velocities", "derivatives", "time",        "trajectory",
       "split",           "test_fraction", "gap_factor", "hamiltonian", "standardize", "threshold",
-      "energy_rollouts", "energy_t_end",  "loss",       "horizon",     "integrator", "dt"};
+      "energy_rollouts", "energy_t_end",  "loss",       "horizon",     "integrator",  "dt"};
   return names;
 }
 

@@ -13,8 +13,8 @@
 #include "physics/integrator.h"
 #include "tasks/evaluate/field_evaluation.h"
 #include "tasks/field_model_run.h"
-#include "tasks/train/field_objective.h"
 #include "tasks/report/json_values.h"
+#include "tasks/train/field_objective.h"
 
 namespace hnn::tasks {
 
@@ -38,7 +38,8 @@ std::vector<Batch> predict_paths(const std::vector<Stretch>& stretches, const Pr
   std::vector<Batch> paths;
   if (shared) {
     Batch x0(Eigen::Index(stretches.size()), stretches[0].x.cols());
-    for (std::size_t i = 0; i < stretches.size(); ++i) x0.row(Eigen::Index(i)) = stretches[i].x.row(0);
+    for (std::size_t i = 0; i < stretches.size(); ++i)
+      x0.row(Eigen::Index(i)) = stretches[i].x.row(0);
     const std::vector<Batch> states = predict(x0, t0);
     for (Eigen::Index i = 0; i < x0.rows(); ++i) {
       Batch path(t0.size(), x0.cols());
@@ -62,7 +63,8 @@ json spread(const std::string& name, const std::vector<double>& v) {
   double mean = 0, var = 0;
   for (double x : v) mean += x / n;
   for (double x : v) var += (x - mean) * (x - mean) / std::max(1.0, n - 1);
-  return {{name, number(mean)}, {name + "_std", number(std::sqrt(var))},
+  return {{name, number(mean)},
+          {name + "_std", number(std::sqrt(var))},
           {name + "_se", number(std::sqrt(var / n))}};
 }
 
@@ -78,7 +80,8 @@ json stretch_errors(const std::string& prefix, const std::vector<Stretch>& stret
     mse.push_back(e.rows() > 1 ? e.bottomRows(e.rows() - 1).array().square().mean() : 0.0);
     double sum = 0;
     for (Eigen::Index k = 0; k < e.rows(); ++k)
-      for (Eigen::Index b = 0; b < bodies; ++b) sum += e.row(k).segment(b * per_body, per_body).norm();
+      for (Eigen::Index b = 0; b < bodies; ++b)
+        sum += e.row(k).segment(b * per_body, per_body).norm();
     position.push_back(std::isfinite(sum) ? sum / double(e.rows() * bodies) : NAN);
   }
   json j = spread(prefix + "state_mse", mse);
@@ -100,9 +103,8 @@ class FieldRun : public FieldModelRun {
                     "without them (use --loss derivative)",
                     task_.name());
     train_windows_ = rollout_windows(stretches_->train, loss_.horizon);
-    const bool any_test =
-        std::any_of(stretches_->test.begin(), stretches_->test.end(),
-                    [&](const Stretch& t) { return t.x.rows() > loss_.horizon; });
+    const bool any_test = std::any_of(stretches_->test.begin(), stretches_->test.end(),
+                                      [&](const Stretch& t) { return t.x.rows() > loss_.horizon; });
     if (any_test) test_windows_ = rollout_windows(stretches_->test, loss_.horizon);
     substeps_ = rollout_substeps(train_windows_, loss_.dt);
     HNN_TASKS_CHECK(s_.train.batch_size <= train_windows_.count(),
@@ -168,11 +170,12 @@ class FieldRun : public FieldModelRun {
     const int per_body = task_.coordinates_per_body();
     json m = stretch_errors("stretch_", test, predict_paths(test, model_predictor()), per_body);
     // The same on training stretches: the gap to the test figure is what generalisation costs.
-    std::vector<Stretch> train(stretches_->train.begin(),
-                               stretches_->train.begin() +
-                                   std::ptrdiff_t(std::min(kMaxStretches, stretches_->train.size())));
-    const json fit = stretch_errors("train_stretch_", train, predict_paths(train, model_predictor()),
-                                    per_body);
+    std::vector<Stretch> train(
+        stretches_->train.begin(),
+        stretches_->train.begin() +
+            std::ptrdiff_t(std::min(kMaxStretches, stretches_->train.size())));
+    const json fit =
+        stretch_errors("train_stretch_", train, predict_paths(train, model_predictor()), per_body);
     m["train_stretch_position_error"] = fit["train_stretch_position_error"];
     m["train_stretch_state_mse"] = fit["train_stretch_state_mse"];
     m["stretch_predictor"] = loss_.rollout ? fmt::format("{}, {} step(s) per interval",
@@ -185,7 +188,8 @@ class FieldRun : public FieldModelRun {
       return integrator->integrate(task_.truth().field(), x0, {t.data(), t.data() + t.size()})
           .states;
     };
-    const json truth = stretch_errors("truth_leapfrog_", test, predict_paths(test, leapfrog), per_body);
+    const json truth =
+        stretch_errors("truth_leapfrog_", test, predict_paths(test, leapfrog), per_body);
     m["truth_leapfrog_position_error"] = truth["truth_leapfrog_position_error"];
     m["truth_leapfrog_position_error_std"] = truth["truth_leapfrog_position_error_std"];
     m["truth_leapfrog_state_mse"] = truth["truth_leapfrog_state_mse"];
@@ -196,8 +200,8 @@ class FieldRun : public FieldModelRun {
     if (!loss_.rollout) {
       return [this](const Batch& x0, const Eigen::VectorXd& t) {
         const auto integrator = physics::make_integrator("dopri5", {.rtol = 1e-9, .atol = 1e-12});
-        return integrator->integrate(learned_field(dynamics()).field, x0,
-                                     {t.data(), t.data() + t.size()})
+        return integrator
+            ->integrate(learned_field(dynamics()).field, x0, {t.data(), t.data() + t.size()})
             .states;
       };
     }
@@ -207,10 +211,9 @@ class FieldRun : public FieldModelRun {
       std::vector<Batch> states{x0};
       ad::Var<double> x = ad::Var<double>::constant(x0);
       for (Eigen::Index k = 1; k < t.size(); ++k) {
-        const ad::Var<double> h = ad::Var<double>::constant(
-            Batch::Constant(x0.rows(), 1, (t(k) - t(k - 1)) / substeps_));
-        for (int s = 0; s < substeps_; ++s)
-          x = integrator_step(dynamics(), x, h, loss_.integrator);
+        const ad::Var<double> h =
+            ad::Var<double>::constant(Batch::Constant(x0.rows(), 1, (t(k) - t(k - 1)) / substeps_));
+        for (int s = 0; s < substeps_; ++s) x = integrator_step(dynamics(), x, h, loss_.integrator);
         states.push_back(x.value());
       }
       return states;

@@ -15,7 +15,8 @@ namespace {
 
 // The SRNN paper's three-body setup (Chen et al. 2020, their script_3body_new): the HNN paper's
 // configurations sampled at dt = 1, 10 points per trajectory (t = 0..9), 100 trajectories to
-// train and 32 to test, each set drawn on its own.
+// train (train_trajectories: more, to measure what the data size costs) and 32 to test, each set
+// drawn on its own.
 constexpr int kSrnnTrain = 100, kSrnnTest = 32, kSrnnPoints = 10;
 constexpr double kSrnnTEnd = 9.0;
 
@@ -45,8 +46,8 @@ Batch srnn_states(const physics::NBody& system, int n, std::mt19937_64& rng) {
   std::array<Eigen::Vector2d, 3> factor;
   for (Eigen::Vector2d& f : factor) f = {1 + 0.2 * unit(rng), 1 + 0.2 * unit(rng)};
   for (int k = 0; k < n; ++k) {
-    const Eigen::Vector2d v1 =
-        turned(position[std::size_t(k)], std::numbers::pi / 2) / std::pow(r[std::size_t(k)], 1.5) * speed;
+    const Eigen::Vector2d v1 = turned(position[std::size_t(k)], std::numbers::pi / 2) /
+                               std::pow(r[std::size_t(k)], 1.5) * speed;
     for (int body = 0; body < 3; ++body) {
       const Eigen::Vector2d q = turned(position[std::size_t(k)], third * body);
       const Eigen::Vector2d v = turned(v1, third * body).cwiseProduct(factor[std::size_t(body)]);
@@ -61,6 +62,8 @@ Batch srnn_states(const physics::NBody& system, int n, std::mt19937_64& rng) {
 
 bool srnn_setup(const RunSettings& settings, const std::string& task) {
   const nlohmann::json& s = settings.task_settings;
+  HNN_TASKS_CHECK(!s.contains("train_trajectories") || s.contains("setup"),
+                  "{}: train_trajectories applies to setup srnn only", task);
   if (!s.contains("setup")) return false;
   HNN_TASKS_CHECK(task == "three-body" && s["setup"] == "srnn",
                   "{}: setup {} is not one of: srnn (three-body only)", task, s["setup"].dump());
@@ -100,9 +103,14 @@ class NBodyTask : public FieldTask {
     if (srnn_setup(settings, name())) {
       Dataset d;
       const Batch test0 = srnn_states(system_, kSrnnTest, rng);
-      const Batch train0 = srnn_states(system_, kSrnnTrain, rng);
-      const TrajectorySamples test = sample_trajectories(system_, test0, kSrnnTEnd, kSrnnPoints, 1e-10);
-      const TrajectorySamples train = sample_trajectories(system_, train0, kSrnnTEnd, kSrnnPoints, 1e-10);
+      const int n = settings.task_settings.value("train_trajectories", kSrnnTrain);
+      HNN_TASKS_CHECK(n >= 1 && n <= 100000,
+                      "three-body: train_trajectories must be 1..100000, got {}", n);
+      const Batch train0 = srnn_states(system_, n, rng);
+      const TrajectorySamples test =
+          sample_trajectories(system_, test0, kSrnnTEnd, kSrnnPoints, 1e-10);
+      const TrajectorySamples train =
+          sample_trajectories(system_, train0, kSrnnTEnd, kSrnnPoints, 1e-10);
       return {train.x, train.dxdt, test.x, test.dxdt};
     }
     const Batch x0 = system_.sample_initial_states(settings_.trajectories, rng);
@@ -115,7 +123,7 @@ class NBodyTask : public FieldTask {
     return d;
   }
   std::vector<std::string> own_setting_names() const override {
-    if (settings_.bodies == 3) return {"setup"};
+    if (settings_.bodies == 3) return {"setup", "train_trajectories"};
     return {};
   }
   int coordinates_per_body() const override { return 2; }

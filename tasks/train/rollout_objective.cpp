@@ -52,11 +52,11 @@ RolloutLossConfig rollout_loss_config(const nlohmann::json& s, const std::string
   } catch (const nlohmann::json::exception& e) {
     throw Error(fmt::format("{}: bad rollout-loss settings {}: {}", task, s.dump(), e.what()));
   }
-  HNN_TASKS_CHECK(c.rollout || (!s.contains("horizon") && !s.contains("integrator") &&
-                                !s.contains("dt")),
-                  "{}: --horizon, --integrator and --dt apply to the rollout loss only (add --loss "
-                  "rollout)",
-                  task);
+  HNN_TASKS_CHECK(
+      c.rollout || (!s.contains("horizon") && !s.contains("integrator") && !s.contains("dt")),
+      "{}: --horizon, --integrator and --dt apply to the rollout loss only (add --loss "
+      "rollout)",
+      task);
   HNN_TASKS_CHECK(c.horizon >= 1, "{}: horizon must be at least 1 step, got {}", task, c.horizon);
   HNN_TASKS_CHECK(!s.contains("dt") || (c.dt > 0 && std::isfinite(c.dt)),
                   "{}: --dt must be a positive step, got {}", task, c.dt);
@@ -76,8 +76,8 @@ int rollout_substeps(const RolloutWindows& w, double dt) {
   HNN_TASKS_CHECK(fits,
                   "--dt {} does not divide the sampling interval ({}{}) into whole steps: use the "
                   "interval divided by a whole number",
-                  dt, shortest, longest > shortest * (1 + 1e-9) ? fmt::format(" to {}", longest)
-                                                                 : std::string());
+                  dt, shortest,
+                  longest > shortest * (1 + 1e-9) ? fmt::format(" to {}", longest) : std::string());
   return int(steps);
 }
 

@@ -37,10 +37,10 @@ Var<T> leapfrog(const nn::DynamicsModel<T>& model, const Var<T>& x, const Var<T>
   const Eigen::Index n = x.cols() / 2;
   const Var<T> half = h * T(0.5);
   const Var<T> q = ad::slice_cols(x, 0, n);
-  const Var<T> p_half = ad::slice_cols(x, n, n) + half * ad::slice_cols(model.time_derivative(x), n, n);
+  const Var<T> p_half =
+      ad::slice_cols(x, n, n) + half * ad::slice_cols(model.time_derivative(x), n, n);
   const Var<T> q1 = q + h * ad::slice_cols(model.time_derivative(join(q, p_half)), 0, n);
-  const Var<T> p1 =
-      p_half + half * ad::slice_cols(model.time_derivative(join(q1, p_half)), n, n);
+  const Var<T> p1 = p_half + half * ad::slice_cols(model.time_derivative(join(q1, p_half)), n, n);
   return join(q1, p1);
 }
 
@@ -115,10 +115,14 @@ Var<T> midpoint(const nn::DynamicsModel<T>& model, const Var<T>& x, const Var<T>
 
 std::string_view to_string(RolloutIntegrator integrator) {
   switch (integrator) {
-    case RolloutIntegrator::kRk4: return "rk4";
-    case RolloutIntegrator::kLeapfrog: return "leapfrog";
-    case RolloutIntegrator::kYoshida4: return "yoshida4";
-    case RolloutIntegrator::kMidpoint: return "midpoint";
+    case RolloutIntegrator::kRk4:
+      return "rk4";
+    case RolloutIntegrator::kLeapfrog:
+      return "leapfrog";
+    case RolloutIntegrator::kYoshida4:
+      return "yoshida4";
+    case RolloutIntegrator::kMidpoint:
+      return "midpoint";
   }
   return "?";
 }
@@ -148,8 +152,8 @@ Matrix<T> field_row_jacobian(const nn::DynamicsModel<T>& model, const Matrix<T>&
 }
 
 template <typename T>
-Matrix<T> midpoint_solve(const nn::DynamicsModel<T>& model, const Matrix<T>& x0,
-                         const Matrix<T>& h, const MidpointSolve& solve) {
+Matrix<T> midpoint_solve(const nn::DynamicsModel<T>& model, const Matrix<T>& x0, const Matrix<T>& h,
+                         const MidpointSolve& solve) {
   const T tolerance = solve.tolerance > 0 ? T(solve.tolerance) : default_tolerance<T>();
   const auto step = [&](const Matrix<T>& f) -> Matrix<T> {
     return x0 + (f.array().colwise() * h.col(0).array()).matrix();
@@ -191,8 +195,10 @@ template <typename T>
 Var<T> integrator_step(const nn::DynamicsModel<T>& model, const Var<T>& x, const Var<T>& h,
                        RolloutIntegrator method, const MidpointSolve& solve) {
   switch (method) {
-    case RolloutIntegrator::kRk4: return rk4(model, x, h);
-    case RolloutIntegrator::kLeapfrog: return leapfrog(model, x, h);
+    case RolloutIntegrator::kRk4:
+      return rk4(model, x, h);
+    case RolloutIntegrator::kLeapfrog:
+      return leapfrog(model, x, h);
     case RolloutIntegrator::kYoshida4: {
       // Yoshida (1990): w1 = 1 / (2 - 2^(1/3)), w0 = 1 - 2 w1.
       const double w1 = 1.0 / (2.0 - std::cbrt(2.0)), w0 = 1.0 - 2.0 * w1;
@@ -201,16 +207,17 @@ Var<T> integrator_step(const nn::DynamicsModel<T>& model, const Var<T>& x, const
       y = leapfrog(model, y, h * T(w0));
       return leapfrog(model, y, outer);
     }
-    case RolloutIntegrator::kMidpoint: return midpoint(model, x, h, solve);
+    case RolloutIntegrator::kMidpoint:
+      return midpoint(model, x, h, solve);
   }
   throw Error("unknown rollout integrator");
 }
 
-#define HNN_INSTANTIATE(T)                                                                       \
-  template Var<T> integrator_step(const nn::DynamicsModel<T>&, const Var<T>&, const Var<T>&,   \
-                                  RolloutIntegrator, const MidpointSolve&);                      \
-  template Matrix<T> midpoint_solve(const nn::DynamicsModel<T>&, const Matrix<T>&,               \
-                                    const Matrix<T>&, const MidpointSolve&);                     \
+#define HNN_INSTANTIATE(T)                                                                   \
+  template Var<T> integrator_step(const nn::DynamicsModel<T>&, const Var<T>&, const Var<T>&, \
+                                  RolloutIntegrator, const MidpointSolve&);                  \
+  template Matrix<T> midpoint_solve(const nn::DynamicsModel<T>&, const Matrix<T>&,           \
+                                    const Matrix<T>&, const MidpointSolve&);                 \
   template Matrix<T> field_row_jacobian(const nn::DynamicsModel<T>&, const Matrix<T>&);
 HNN_INSTANTIATE(float)
 HNN_INSTANTIATE(double)

@@ -18,17 +18,16 @@ struct BadTrain {
 TEST(RolloutCli, TrainsThroughLeapfrogAndRefusesBadSettingsInOneLine) {
   const TempDir dir;
   const std::string out = (dir / "run").string();
-  const Result good = run_hnn({"train", "spring", "--loss", "rollout", "--integrator", "leapfrog",
-                               "--horizon", "2", "--dt", "0.5", "--settings",
-                               "{\"sample_dt\": 1.0}", "--steps", "20", "--hidden", "8",
-                               "--quiet", "--out", out},
-                              dir.path());
+  const Result good =
+      run_hnn({"train", "spring", "--loss", "rollout", "--integrator", "leapfrog", "--horizon", "2",
+               "--dt", "0.5", "--settings", "{\"sample_dt\": 1.0}", "--steps", "20", "--hidden",
+               "8", "--quiet", "--out", out},
+              dir.path());
   ASSERT_EQ(good.code, 0) << good.err;
   const nlohmann::json m = read_json(dir / "run" / "metrics.json");
-  EXPECT_EQ(m["training"], nlohmann::json({{"loss", "rollout"},
-                                           {"integrator", "leapfrog"},
-                                           {"horizon", 2},
-                                           {"dt", 0.5}}));
+  EXPECT_EQ(m["training"],
+            nlohmann::json(
+                {{"loss", "rollout"}, {"integrator", "leapfrog"}, {"horizon", 2}, {"dt", 0.5}}));
   EXPECT_EQ(m["task_settings"]["integrator"], "leapfrog");
   EXPECT_EQ(m["stretch_predictor"], "leapfrog, 2 step(s) per interval");
   fs::remove_all(dir / "run");

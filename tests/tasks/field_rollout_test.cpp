@@ -59,19 +59,17 @@ TEST(FieldRollout, ARolloutRunOnTheSpringLearns) {
   for (const char* integrator : {"leapfrog", "midpoint"}) {
     const RunSettings s = settings(
         "spring",
-        {{"sample_dt", 0.5}, {"loss", "rollout"}, {"horizon", 3}, {"integrator", integrator}},
-        150);
+        {{"sample_dt", 0.5}, {"loss", "rollout"}, {"horizon", 3}, {"integrator", integrator}}, 150);
     const auto task = make_field_task("spring");
     const std::unique_ptr<TaskRun> run = task->open(s);
     const TrainResult r = run->train({.quiet = true});
     ASSERT_GE(r.curve.size(), 2u);
     EXPECT_LT(r.curve.back().train_loss, 0.3 * r.curve.front().train_loss) << integrator;
     const nlohmann::json m = run->evaluate(nullptr);
-    EXPECT_EQ(m["training"],
-              nlohmann::json({{"loss", "rollout"},
-                              {"integrator", integrator},
-                              {"horizon", 3},
-                              {"dt", "sampling interval"}}));
+    EXPECT_EQ(m["training"], nlohmann::json({{"loss", "rollout"},
+                                             {"integrator", integrator},
+                                             {"horizon", 3},
+                                             {"dt", "sampling interval"}}));
     EXPECT_LT(m["stretch_state_mse"].get<double>(), 0.2) << m.dump();
     EXPECT_EQ(m["n_stretches"], 25);
   }
@@ -91,8 +89,9 @@ TEST(FieldRollout, SubStepsDivideTheIntervalOrAreRefused) {
   }
   EXPECT_THROW(settings("spring", {{"horizon", 2}}), Error);
   EXPECT_THROW(task->open(settings("spring", {{"loss", "rollout"}, {"horizon", 30}})), Error);
-  EXPECT_THROW(make_field_task("damped-spring")->open(settings("damped-spring", {{"loss", "rollout"}})),
-               Error);
+  EXPECT_THROW(
+      make_field_task("damped-spring")->open(settings("damped-spring", {{"loss", "rollout"}})),
+      Error);
 }
 
 }  // namespace

@@ -10,9 +10,9 @@
 #include <random>
 
 #include "autodiff/autodiff.h"
-#include "nn/optim.h"
 #include "nn/hnn.h"
 #include "nn/malloc_counter.h"
+#include "nn/optim.h"
 #include "tasks/train/rollout_objective.h"
 
 namespace {
@@ -66,12 +66,11 @@ long allocations(RolloutIntegrator method, int warmup, int steps) {
   std::mt19937_64 rng(3);
   std::vector<Stretch> stretches;
   Eigen::VectorXd t = Eigen::VectorXd::LinSpaced(8, 0.0, 3.5);
-  for (int k = 0; k < 10; ++k)
-    stretches.push_back({t, nn::random_normal<double>(8, 2, rng, 0, 1)});
+  for (int k = 0; k < 10; ++k) stretches.push_back({t, nn::random_normal<double>(8, 2, rng, 0, 1)});
   const auto model =
       nn::make_model<double>({.model = nn::ModelKind::kHnn, .dim = 2, .hidden = {32, 32}}, rng);
-  RolloutObjective<double> objective(*model, rollout_windows(stretches, 3), {}, 32, {.lr = 1e-3},
-                                     1, method);
+  RolloutObjective<double> objective(*model, rollout_windows(stretches, 3), {}, 32, {.lr = 1e-3}, 1,
+                                     method);
   nn::Adam<double> adam(model->parameters(), {.lr = 1e-3});
   std::vector<ad::Var<double>> grads;
   long counted = 0;
@@ -93,8 +92,8 @@ TEST(RolloutAllocations, ExplicitIntegratorStepsAllocateNothingAfterWarmUp) {
 #ifndef HNN_COUNT_ALLOCATIONS
   GTEST_SKIP() << "malloc belongs to the sanitizer in this build";
 #endif
-  for (RolloutIntegrator method : {RolloutIntegrator::kLeapfrog, RolloutIntegrator::kYoshida4,
-                                   RolloutIntegrator::kRk4}) {
+  for (RolloutIntegrator method :
+       {RolloutIntegrator::kLeapfrog, RolloutIntegrator::kYoshida4, RolloutIntegrator::kRk4}) {
     EXPECT_EQ(allocations(method, 3, 10), 0) << to_string(method);
   }
   // The midpoint's solve works on plain matrices: it allocates, and says how much.

@@ -34,7 +34,9 @@ class KnownField : public nn::DynamicsModel<double> {
   }
 
  private:
-  static nn::DynamicsConfig config() { return {.model = nn::ModelKind::kBaseline, .dim = 2, .hidden = {2}}; }
+  static nn::DynamicsConfig config() {
+    return {.model = nn::ModelKind::kBaseline, .dim = 2, .hidden = {2}};
+  }
   static nn::Mlp<double> mlp() {
     std::mt19937_64 rng(0);
     return nn::Mlp<double>(nn::mlp_config(config()), rng);
@@ -46,10 +48,14 @@ Var q_of(const Var& x) { return ad::slice_cols(x, 0, 1); }
 Var p_of(const Var& x) { return ad::slice_cols(x, 1, 1); }
 
 // H = (q^2 + p^2) / 2.
-KnownField spring() { return KnownField([](const Var& x) { return ad::concat_cols<double>({p_of(x), -q_of(x)}); }); }
+KnownField spring() {
+  return KnownField([](const Var& x) { return ad::concat_cols<double>({p_of(x), -q_of(x)}); });
+}
 // H = p^2 / 2 + 1 - cos q.
 KnownField pendulum() {
-  return KnownField([](const Var& x) { return ad::concat_cols<double>({p_of(x), -ad::sin(q_of(x))}); });
+  return KnownField([](const Var& x) {
+    return ad::concat_cols<double>({p_of(x), -ad::sin(q_of(x))});
+  });
 }
 // H = (q^2 + p^2) / 2 + q^2 p^2 / 2: not separable.
 KnownField coupled() {
@@ -130,7 +136,8 @@ TEST(RolloutIntegrators, SymplecticOnesConserveAQuadraticEnergyWhereRk4Drifts) {
 // gradient in x0 and in a weight against central differences of the converged map.
 TEST(RolloutIntegrators, MidpointGradientMatchesFiniteDifferencesOfTheConvergedMap) {
   std::mt19937_64 rng(5);
-  auto model = nn::make_model<double>({.model = nn::ModelKind::kHnn, .dim = 2, .hidden = {16, 16}}, rng);
+  auto model =
+      nn::make_model<double>({.model = nn::ModelKind::kHnn, .dim = 2, .hidden = {16, 16}}, rng);
   const Matrix x0{{0.6, -0.3}, {-0.2, 0.9}};
   const Matrix h{{0.4}, {0.3}};
   const Matrix w{{1.0, -2.0}, {0.5, 1.5}};
@@ -182,8 +189,8 @@ TEST(RolloutIntegrators, AMidpointStepThatCannotConvergeNamesItsRow) {
     midpoint_solve<double>(model, x0, Matrix{{0.1}, {0.1}}, {.max_iterations = 1});
     FAIL() << "a solve with one iteration converged";
   } catch (const Error& e) {
-    EXPECT_TRUE(std::string(e.what()).starts_with(
-        "the implicit midpoint step did not converge: row "))
+    EXPECT_TRUE(
+        std::string(e.what()).starts_with("the implicit midpoint step did not converge: row "))
         << e.what();
   }
 }
