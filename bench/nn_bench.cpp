@@ -1,7 +1,8 @@
 // One full-batch training step of the paper's models on the mass-spring task (750 x 2 inputs,
 // 2-200-200-out tanh MLP): forward, the HNN's inner gradient, loss, parameter gradients and
 // Adam, in float and double, on 1 and 2 threads (wall time: the workers' CPU time is not the
-// caller's). Also the learned field's evaluation, as rollouts call it.
+// caller's). Also the learned field's evaluation, as rollouts call it, and one training step of
+// the rollout loss (tasks/train/rollout_objective.h) through each integrator.
 
 #include <benchmark/benchmark.h>
 
@@ -10,6 +11,7 @@
 
 #include "autodiff/autodiff.h"
 #include "nn/nn.h"
+#include "tasks/train/rollout_objective.h"
 
 namespace ad = hnn::ad;
 namespace nn = hnn::nn;
@@ -90,8 +92,43 @@ void BM_HnnField(benchmark::State& state) {
   for (auto _ : state) benchmark::DoNotOptimize(model.field(x));
 }
 
+// One rollout-loss training step of the spring HNN (2-200-200-1): a batch of 128 windows of
+// horizon 4 from the 25 trajectories, integrated by the method (range 1), loss, parameter
+// gradients through the steps and Adam. Double, 2 threads.
+void BM_RolloutStep(benchmark::State& state) {
+  ad::set_num_threads(2);
+  const Data data = spring_data();
+  std::vector<hnn::tasks::Stretch> stretches;
+  Eigen::VectorXd t(30);
+  for (int i = 0; i < 30; ++i) t(i) = 3.0 * i / 29;
+  for (int k = 0; k < 25; ++k) stretches.push_back({t, data.x.middleRows(k * 30, 30)});
+  std::mt19937_64 rng(1);
+  const auto model = nn::make_model<double>(nn::DynamicsConfig{}, rng);
+  const auto method = hnn::tasks::RolloutIntegrator(state.range(0));
+  hnn::tasks::RolloutObjective<double> objective(*model, hnn::tasks::rollout_windows(stretches, 4),
+                                                 {}, 128, {.lr = 1e-3}, 2, method);
+  nn::Adam<double> adam(model->parameters(), {.lr = 1e-3});
+  std::vector<ad::Var<double>> grads;
+  double loss = 0;
+  for (auto _ : state) {
+    ad::TapeScope scope;
+    objective.sampler().next();
+    const ad::Var<double> l = objective.batch_loss();
+    ad::grad_into(l, adam.parameters(), grads);
+    adam.step(grads);
+    loss = l.item();
+  }
+  state.SetLabel(std::string(hnn::tasks::to_string(method)));
+  state.counters["loss"] = loss;
+}
+
 }  // namespace
 
+BENCHMARK(BM_RolloutStep)
+    ->Unit(benchmark::kMillisecond)
+    ->ArgName("integrator")
+    ->DenseRange(0, 3)
+    ->UseRealTime();
 BENCHMARK(BM_HnnStep<float>)
     ->Unit(benchmark::kMillisecond)
     ->ArgName("threads")

@@ -30,16 +30,15 @@ struct DataConfig {
   bool standardize = true;
   double threshold = 0.1;
   int energy_rollouts = 15;
-  double energy_t_end = 0;    ///< 0: the held-out stretches' median duration
-  bool rollout_loss = false;  ///< train through an integrator (else on dx/dt)
-  int horizon = 1;            ///< steps of the rollout loss
+  double energy_t_end = 0;   ///< 0: the held-out stretches' median duration
+  RolloutLossConfig loss{};  ///< dx/dt targets, or through an integrator
 };
 
 const std::vector<std::string>& setting_names() {
   static const std::vector<std::string> names = {
       "coords",          "momenta",       "velocities", "derivatives", "time",        "trajectory",
       "split",           "test_fraction", "gap_factor", "hamiltonian", "standardize", "threshold",
-      "energy_rollouts", "energy_t_end",  "loss",       "horizon",     "integrator"};
+      "energy_rollouts", "energy_t_end",  "loss",       "horizon",     "integrator",  "dt"};
   return names;
 }
 
@@ -76,22 +75,10 @@ DataConfig data_config(const json& s) {
     c.threshold = s.value("threshold", c.threshold);
     c.energy_rollouts = json_integer<int>(s.value("energy_rollouts", json(15)), "energy_rollouts");
     c.energy_t_end = s.value("energy_t_end", 0.0);
-    const std::string loss = s.value("loss", std::string("derivative"));
-    HNN_TASKS_CHECK(loss == "derivative" || loss == "rollout",
-                    "data: loss '{}' is not one of derivative, rollout", loss);
-    c.rollout_loss = loss == "rollout";
-    c.horizon = json_integer<int>(s.value("horizon", json(1)), "horizon");
-    const std::string integrator = s.value("integrator", std::string("rk4"));
-    HNN_TASKS_CHECK(integrator == "rk4",
-                    "data: the rollout loss integrates with rk4; '{}' is not differentiable here "
-                    "yet (leapfrog, yoshida4 and the implicit midpoint are issue 18's open work)",
-                    integrator);
   } catch (const json::exception& e) {
     throw Error(fmt::format("data: bad task settings {}: {}", s.dump(), e.what()));
   }
-  HNN_TASKS_CHECK(c.horizon >= 1, "data: horizon must be at least 1 step, got {}", c.horizon);
-  HNN_TASKS_CHECK(c.rollout_loss || (!s.contains("horizon") && !s.contains("integrator")),
-                  "data: horizon and integrator apply to the rollout loss only (--loss rollout)");
+  c.loss = rollout_loss_config(s, "data");
   HNN_TASKS_CHECK(c.threshold > 0 && c.threshold < 1,
                   "data: threshold {} is not between 0 and 1 (a relative state error)",
                   c.threshold);
@@ -175,13 +162,15 @@ class DataRun : public FieldModelRun {
  public:
   DataRun(RunSettings settings, Prepared p)
       : FieldModelRun(std::move(settings), p.units.to_model(p.measured.data)), p_(std::move(p)) {
-    if (!p_.config.rollout_loss) return;
+    const RolloutLossConfig& loss = p_.config.loss;
+    if (!loss.rollout) return;
     // Checked here, before a run folder exists.
-    train_windows_ = rollout_windows(stretches(p_.measured.train_stretches), p_.config.horizon);
+    train_windows_ = rollout_windows(stretches(p_.measured.train_stretches), loss.horizon);
     const std::vector<Stretch> test = stretches(p_.measured.held_out);
-    const bool any_test = std::any_of(
-        test.begin(), test.end(), [&](const Stretch& t) { return t.x.rows() > p_.config.horizon; });
-    if (any_test) test_windows_ = rollout_windows(test, p_.config.horizon);
+    const bool any_test = std::any_of(test.begin(), test.end(),
+                                      [&](const Stretch& t) { return t.x.rows() > loss.horizon; });
+    if (any_test) test_windows_ = rollout_windows(test, loss.horizon);
+    substeps_ = rollout_substeps(train_windows_, loss.dt / p_.units.time);
     HNN_TASKS_CHECK(s_.train.batch_size <= train_windows_.count(),
                     "--batch {} is larger than the {} rollout windows of the training set",
                     s_.train.batch_size, train_windows_.count());
@@ -189,12 +178,13 @@ class DataRun : public FieldModelRun {
 
   // The rollout loss trains from the states alone; the derivative loss as every field task.
   TrainResult train(const LoopOptions& loop) override {
-    if (!p_.config.rollout_loss) return FieldModelRun::train(loop);
+    if (!p_.config.loss.rollout) return FieldModelRun::train(loop);
     return with_scalar(s_.dtype, [&]<typename T>() {
       std::unique_ptr<nn::DynamicsModel<T>> model = fresh_model<T>();
       RolloutObjective<T> objective(
           *model, train_windows_, test_windows_, s_.train.batch_size,
-          {.lr = s_.train.learning_rate, .weight_decay = s_.train.weight_decay}, s_.seed);
+          {.lr = s_.train.learning_rate, .weight_decay = s_.train.weight_decay}, s_.seed,
+          p_.config.loss.integrator, substeps_);
       LoopOptions o = loop;
       o.steps = s_.train.steps;
       o.record_every = s_.train.record_every;
@@ -227,6 +217,7 @@ class DataRun : public FieldModelRun {
           dynamics(), data_.test_x, [&](const Batch& f) { return p_.units.rate_to_file(f); }));
     }
     m.update(energy_metrics(file));
+    m["training"] = p_.config.loss.to_json();
     m["units"] = p_.units.to_json();
     m["state_names"] = p_.measured.state_names;
     m["data"] = describe(p_.measured);
@@ -346,6 +337,7 @@ class DataRun : public FieldModelRun {
 
   Prepared p_;
   RolloutWindows train_windows_{}, test_windows_{};
+  int substeps_ = 1;
 };
 
 class DataTask : public Task {

@@ -66,10 +66,9 @@ class DoublePendulumTask : public FieldTask {
     c.points = std::max(2, int(std::lround(c.t_end * 10)) + 1);
     return c;
   }
+  std::vector<std::string> own_setting_names() const override { return {"rollouts", "t_end"}; }
   void check_task_settings(const nlohmann::json& s) const override {
-    for (const auto& [key, value] : s.items())
-      HNN_TASKS_CHECK(key == "rollouts" || key == "t_end",
-                      "double-pendulum has no setting '{}' (known: rollouts, t_end)", key);
+    FieldTask::check_task_settings(s);
     const RolloutConfig c = rollout_config(s);
     HNN_TASKS_CHECK(c.trajectories >= 1 && c.trajectories <= kMaxRollouts,
                     "double-pendulum: rollouts must be in 1..{}, got {}", kMaxRollouts,

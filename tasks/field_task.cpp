@@ -1,23 +1,134 @@
-// The run of a field task: train a dynamics model on the task's dataset with FieldObjective,
-// evaluate it against the true system, save and load it, roll it out.
+// The run of a field task: train a dynamics model on the task's dataset (with FieldObjective on
+// dx/dt targets, or through an integrator with RolloutObjective), evaluate it against the true
+// system, save and load it, roll it out.
 
 #include "tasks/field_task.h"
 
+#include <fmt/ranges.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "autodiff/tape.h"
 #include "physics/integrator.h"
 #include "tasks/evaluate/field_evaluation.h"
 #include "tasks/field_model_run.h"
+#include "tasks/report/json_values.h"
 #include "tasks/train/field_objective.h"
 
 namespace hnn::tasks {
 
 namespace {
 
+using nlohmann::json;
+
+// The held-out error along stretches looks at this many test stretches at most.
+constexpr std::size_t kMaxStretches = 200;
+
+// States at a stretch's times from its first state (times x dim per stretch, batched).
+using Predictor = std::function<std::vector<Batch>(const Batch& x0, const Eigen::VectorXd& t)>;
+
+// Every stretch predicted from its first state: one batched call when the stretches share their
+// times (the simulated tasks), else one call per stretch. Result: one path (points x dim) each.
+std::vector<Batch> predict_paths(const std::vector<Stretch>& stretches, const Predictor& predict) {
+  const Eigen::VectorXd t0 = stretches[0].t.array() - stretches[0].t(0);
+  const bool shared = std::all_of(stretches.begin(), stretches.end(), [&](const Stretch& s) {
+    return s.t.size() == t0.size() && ((s.t.array() - s.t(0)) - t0.array()).abs().maxCoeff() < 1e-9;
+  });
+  std::vector<Batch> paths;
+  if (shared) {
+    Batch x0(Eigen::Index(stretches.size()), stretches[0].x.cols());
+    for (std::size_t i = 0; i < stretches.size(); ++i)
+      x0.row(Eigen::Index(i)) = stretches[i].x.row(0);
+    const std::vector<Batch> states = predict(x0, t0);
+    for (Eigen::Index i = 0; i < x0.rows(); ++i) {
+      Batch path(t0.size(), x0.cols());
+      for (Eigen::Index k = 0; k < t0.size(); ++k) path.row(k) = states[std::size_t(k)].row(i);
+      paths.push_back(std::move(path));
+    }
+    return paths;
+  }
+  for (const Stretch& s : stretches) {
+    const std::vector<Batch> states = predict(s.x.topRows(1), s.t.array() - s.t(0));
+    Batch path(s.t.size(), s.x.cols());
+    for (Eigen::Index k = 0; k < s.t.size(); ++k) path.row(k) = states[std::size_t(k)].row(0);
+    paths.push_back(std::move(path));
+  }
+  return paths;
+}
+
+// Mean, standard deviation and standard error of per-stretch values.
+json spread(const std::string& name, const std::vector<double>& v) {
+  const double n = double(v.size());
+  double mean = 0, var = 0;
+  for (double x : v) mean += x / n;
+  for (double x : v) var += (x - mean) * (x - mean) / std::max(1.0, n - 1);
+  return {{name, number(mean)},
+          {name + "_std", number(std::sqrt(var))},
+          {name + "_se", number(std::sqrt(var / n))}};
+}
+
+// The held-out error of predicted paths against the stretches: state MSE over the points after
+// the start, and the position error (SRNN's measure: the Euclidean distance of each body's
+// position, averaged over the bodies and over every sampled time, the start included).
+json stretch_errors(const std::string& prefix, const std::vector<Stretch>& stretches,
+                    const std::vector<Batch>& paths, int per_body) {
+  std::vector<double> mse, position;
+  for (std::size_t i = 0; i < stretches.size(); ++i) {
+    const Batch e = paths[i] - stretches[i].x;
+    const Eigen::Index n = e.cols() / 2, bodies = n / per_body;
+    mse.push_back(e.rows() > 1 ? e.bottomRows(e.rows() - 1).array().square().mean() : 0.0);
+    double sum = 0;
+    for (Eigen::Index k = 0; k < e.rows(); ++k)
+      for (Eigen::Index b = 0; b < bodies; ++b)
+        sum += e.row(k).segment(b * per_body, per_body).norm();
+    position.push_back(std::isfinite(sum) ? sum / double(e.rows() * bodies) : NAN);
+  }
+  json j = spread(prefix + "state_mse", mse);
+  j.update(spread(prefix + "position_error", position));
+  return j;
+}
+
 class FieldRun : public FieldModelRun {
  public:
   FieldRun(const FieldTask& task, RunSettings settings)
       : FieldModelRun(settings, task.build_dataset(settings),
                       {.angles = task.angle_coordinates(), .input_scale = task.input_scale()}),
-        task_(task) {}
+        task_(task),
+        loss_(rollout_loss_config(s_.task_settings, task.name())) {
+    stretches_ = task_.stretches(s_, data_);
+    if (!loss_.rollout) return;
+    // Checked here, before a run folder exists.
+    HNN_TASKS_CHECK(stretches_.has_value(),
+                    "{}: the rollout loss needs trajectories, and this task's data are states "
+                    "without them (use --loss derivative)",
+                    task_.name());
+    train_windows_ = rollout_windows(stretches_->train, loss_.horizon);
+    const bool any_test = std::any_of(stretches_->test.begin(), stretches_->test.end(),
+                                      [&](const Stretch& t) { return t.x.rows() > loss_.horizon; });
+    if (any_test) test_windows_ = rollout_windows(stretches_->test, loss_.horizon);
+    substeps_ = rollout_substeps(train_windows_, loss_.dt);
+    HNN_TASKS_CHECK(s_.train.batch_size <= train_windows_.count(),
+                    "--batch {} is larger than the {} rollout windows of the training set",
+                    s_.train.batch_size, train_windows_.count());
+  }
+
+  TrainResult train(const LoopOptions& loop) override {
+    if (!loss_.rollout) return FieldModelRun::train(loop);
+    return with_scalar(s_.dtype, [&]<typename T>() {
+      std::unique_ptr<nn::DynamicsModel<T>> model = fresh_model<T>();
+      RolloutObjective<T> objective(
+          *model, train_windows_, test_windows_, s_.train.batch_size,
+          {.lr = s_.train.learning_rate, .weight_decay = s_.train.weight_decay}, s_.seed,
+          loss_.integrator, substeps_);
+      LoopOptions o = loop;
+      o.steps = s_.train.steps;
+      o.record_every = s_.train.record_every;
+      const TrainResult result = tasks::train(objective, o);
+      keep(std::move(model));
+      return result;
+    });
+  }
 
   nlohmann::json evaluate(const RunFolder* folder) const override {
     const RolloutConfig config = task_.rollout_config(s_.task_settings);
@@ -25,7 +136,10 @@ class FieldRun : public FieldModelRun {
                                              rollout_states(config.trajectories), config);
     task_.add_metrics(e.rollouts, e.metrics);
     if (folder) folder->write_text("rollout.csv", tasks::rollout_csv(e.rollouts));
-    return e.metrics;
+    json m = e.metrics;
+    m["training"] = loss_.to_json();
+    if (stretches_ && !stretches_->test.empty()) m.update(held_out_stretches());
+    return m;
   }
 
   std::string rollout_csv(const RolloutRequest& r) const override {
@@ -47,7 +161,72 @@ class FieldRun : public FieldModelRun {
   double rollout_span() const override { return task_.rollout_config(s_.task_settings).t_end; }
 
  private:
+  // The model (and the truth by leapfrog, one step per interval) from the first state of each
+  // test stretch along its times. A rollout-trained model steps as it trained (its integrator
+  // and sub-steps: the discrete map it learned); a derivative-trained one is integrated
+  // accurately (dopri5), the best use of a learned field.
+  json held_out_stretches() const {
+    std::vector<Stretch> test(stretches_->test.begin(),
+                              stretches_->test.begin() +
+                                  std::ptrdiff_t(std::min(kMaxStretches, stretches_->test.size())));
+    const int per_body = task_.coordinates_per_body();
+    json m = stretch_errors("stretch_", test, predict_paths(test, model_predictor()), per_body);
+    // The same on training stretches: the gap to the test figure is what generalisation costs.
+    std::vector<Stretch> train(
+        stretches_->train.begin(),
+        stretches_->train.begin() +
+            std::ptrdiff_t(std::min(kMaxStretches, stretches_->train.size())));
+    const json fit =
+        stretch_errors("train_stretch_", train, predict_paths(train, model_predictor()), per_body);
+    m["train_stretch_position_error"] = fit["train_stretch_position_error"];
+    m["train_stretch_state_mse"] = fit["train_stretch_state_mse"];
+    m["stretch_predictor"] = loss_.rollout ? fmt::format("{}, {} step(s) per interval",
+                                                         to_string(loss_.integrator), substeps_)
+                                           : std::string("dopri5 (rtol 1e-9)");
+    m["n_stretches"] = test.size();
+    const Predictor leapfrog = [&](const Batch& x0, const Eigen::VectorXd& t) {
+      const double interval = t.size() > 1 ? t(1) - t(0) : 1.0;
+      const auto integrator = physics::make_integrator("leapfrog", {.dt = interval * (1 + 1e-9)});
+      return integrator->integrate(task_.truth().field(), x0, {t.data(), t.data() + t.size()})
+          .states;
+    };
+    const json truth =
+        stretch_errors("truth_leapfrog_", test, predict_paths(test, leapfrog), per_body);
+    m["truth_leapfrog_position_error"] = truth["truth_leapfrog_position_error"];
+    m["truth_leapfrog_position_error_std"] = truth["truth_leapfrog_position_error_std"];
+    m["truth_leapfrog_state_mse"] = truth["truth_leapfrog_state_mse"];
+    return m;
+  }
+
+  Predictor model_predictor() const {
+    if (!loss_.rollout) {
+      return [this](const Batch& x0, const Eigen::VectorXd& t) {
+        const auto integrator = physics::make_integrator("dopri5", {.rtol = 1e-9, .atol = 1e-12});
+        return integrator
+            ->integrate(learned_field(dynamics()).field, x0, {t.data(), t.data() + t.size()})
+            .states;
+      };
+    }
+    return [this](const Batch& x0, const Eigen::VectorXd& t) {
+      ad::TapeScope scope;
+      ad::NoGradGuard values_only;
+      std::vector<Batch> states{x0};
+      ad::Var<double> x = ad::Var<double>::constant(x0);
+      for (Eigen::Index k = 1; k < t.size(); ++k) {
+        const ad::Var<double> h =
+            ad::Var<double>::constant(Batch::Constant(x0.rows(), 1, (t(k) - t(k - 1)) / substeps_));
+        for (int s = 0; s < substeps_; ++s) x = integrator_step(dynamics(), x, h, loss_.integrator);
+        states.push_back(x.value());
+      }
+      return states;
+    };
+  }
+
   const FieldTask& task_;
+  RolloutLossConfig loss_;
+  std::optional<SplitStretches> stretches_;
+  RolloutWindows train_windows_{}, test_windows_{};
+  int substeps_ = 1;
 };
 
 }  // namespace
@@ -55,6 +234,53 @@ class FieldRun : public FieldModelRun {
 void FieldTask::add_metrics(const Rollouts&, nlohmann::json&) const {}
 
 RolloutConfig FieldTask::rollout_config(const nlohmann::json&) const { return rollout_config(); }
+std::vector<Stretch> regular_stretches(const Batch& x, int points, double t_end) {
+  const std::vector<double> t = physics::linspace(0.0, t_end, points);
+  const Eigen::VectorXd times = Eigen::Map<const Eigen::VectorXd>(t.data(), points);
+  std::vector<Stretch> out;
+  for (Eigen::Index start = 0; start + points <= x.rows(); start += points)
+    out.push_back({times, x.middleRows(start, points)});
+  return out;
+}
+
+OscillatorSettings oscillator_settings(const nlohmann::json& s, OscillatorSettings paper,
+                                       const std::string& task) {
+  OscillatorSettings o = paper;
+  try {
+    if (s.contains("t_end")) o.t_end = s["t_end"].get<double>();
+    HNN_TASKS_CHECK(o.t_end > 0 && std::isfinite(o.t_end), "{}: t_end must be positive, got {}",
+                    task, o.t_end);
+    const double interval =
+        s.contains("sample_dt") ? s["sample_dt"].get<double>() : paper.t_end / (paper.points - 1);
+    HNN_TASKS_CHECK(interval > 0 && std::isfinite(interval),
+                    "{}: sample_dt must be positive, got {}", task, interval);
+    if (!s.contains("t_end") && !s.contains("sample_dt")) return paper;
+    const double intervals = std::round(o.t_end / interval);
+    HNN_TASKS_CHECK(intervals >= 1 && std::abs(o.t_end / interval - intervals) < 1e-6 * intervals,
+                    "{}: sample_dt {} does not divide t_end {} into whole intervals", task,
+                    interval, o.t_end);
+    o.points = int(intervals) + 1;
+  } catch (const nlohmann::json::exception& e) {
+    throw Error(fmt::format("{}: bad settings {}: {}", task, s.dump(), e.what()));
+  }
+  return o;
+}
+
+std::optional<SplitStretches> FieldTask::stretches(const RunSettings&, const Dataset&) const {
+  return std::nullopt;
+}
+
+void FieldTask::check_task_settings(const nlohmann::json& settings) const {
+  const std::vector<std::string> own = own_setting_names();
+  std::vector<std::string> known = rollout_setting_names();
+  known.insert(known.end(), own.begin(), own.end());
+  for (const auto& [key, value] : settings.items()) {
+    HNN_TASKS_CHECK(std::find(known.begin(), known.end(), key) != known.end(),
+                    "task '{}' has no setting '{}' (known: {})", name(), key,
+                    fmt::join(known, ", "));
+  }
+  rollout_loss_config(settings, name());
+}
 
 std::unique_ptr<TaskRun> FieldTask::open(const RunSettings& settings) const {
   return std::make_unique<FieldRun>(*this, settings);

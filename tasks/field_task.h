@@ -5,15 +5,32 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <random>
 #include <string>
 
 #include "physics/system.h"
 #include "tasks/data/dataset.h"
+#include "tasks/data/trajectories.h"
 #include "tasks/evaluate/rollouts.h"
 #include "tasks/task.h"
+#include "tasks/train/rollout_objective.h"
 
 namespace hnn::tasks {
+
+/// A dataset's rows as stretches of one trajectory each, split as the dataset is.
+struct SplitStretches {
+  std::vector<Stretch> train, test;
+};
+
+/// Rows in blocks of `points` consecutive states, sampled at linspace(0, t_end, points).
+std::vector<Stretch> regular_stretches(const Batch& x, int points, double t_end);
+
+/// Spring and pendulum: the task settings "t_end" (each trajectory's span) and "sample_dt" (the
+/// sampling interval, which must divide t_end) over the paper's sampling; throws Error naming
+/// `task` on a bad value. Without them, `paper` as it is.
+OscillatorSettings oscillator_settings(const nlohmann::json& settings, OscillatorSettings paper,
+                                       const std::string& task);
 
 class FieldTask : public Task {
  public:
@@ -35,6 +52,19 @@ class FieldTask : public Task {
   virtual Eigen::Index angle_coordinates() const { return 0; }
   /// The models' input scales (nn::DynamicsConfig::input_scale); by default none.
   virtual std::vector<double> input_scale() const { return {}; }
+
+  /// The dataset's rows as stretches along their trajectories (consecutive states with their
+  /// times), split as `data` is: what the rollout loss trains on and its held-out error is
+  /// measured on. By default none: rows that are not trajectories (a grid of states, say).
+  virtual std::optional<SplitStretches> stretches(const RunSettings& settings,
+                                                  const Dataset& data) const;
+  /// Position coordinates per body, for the position error (2 for the planar n-body tasks).
+  virtual int coordinates_per_body() const { return 1; }
+  /// The task's own settings besides the rollout loss's (loss, horizon, integrator, dt).
+  virtual std::vector<std::string> own_setting_names() const { return {}; }
+  /// Checks the rollout-loss keys and own_setting_names(); a task with settings of its own
+  /// checks their values in build_dataset (before a run folder exists).
+  void check_task_settings(const nlohmann::json& settings) const override;
 
   /// A FieldRun of this task; the task must outlive it.
   std::unique_ptr<TaskRun> open(const RunSettings& settings) const override;

@@ -25,8 +25,7 @@ class RealPendulumTask : public FieldTask {
   // The `lean` preset (docs/speed_accuracy.md, chart 4): within the noise of 200-200.
   std::vector<int> lean_hidden() const override { return {16, 16}; }
   Dataset build_dataset(const RunSettings& settings) const override {
-    const physics::LipsonData data = physics::load_lipson(
-        settings.data_file.empty() ? default_data_path(kDataFile) : settings.data_file);
+    const physics::LipsonData data = load(settings);
     Batch x, dxdt;
     forward_differences(data, x, dxdt);
     const Eigen::Index cut = x.rows() * 8 / 10;  // order kept: the test set is the run's end
@@ -50,8 +49,42 @@ class RealPendulumTask : public FieldTask {
                : PaperRow{{2.7455e-3, 2.1e-4}, {2.1864e-3, 3.3e-4}, {3.8564e-1, 6.9e-2}};
   }
   bool reads_data_file() const override { return true; }
+  // Consecutive rows of one trial on one side of the split, at the file's times.
+  std::optional<SplitStretches> stretches(const RunSettings& settings,
+                                          const Dataset& data) const override {
+    const physics::LipsonData file = load(settings);
+    const std::vector<Eigen::Index> rows = sample_rows(file);
+    const Eigen::MatrixXd state = file.state().leftCols(2);
+    const auto cut = std::size_t(data.train_x.rows());
+    SplitStretches out;
+    for (std::size_t k = 0; k < rows.size();) {
+      std::size_t end = k + 1;
+      while (end < rows.size() && end != cut && file.trial(rows[end]) == file.trial(rows[k])) ++end;
+      Stretch s{Eigen::VectorXd(Eigen::Index(end - k)), Batch(Eigen::Index(end - k), 2)};
+      for (std::size_t i = k; i < end; ++i) {
+        s.t(Eigen::Index(i - k)) = file.t(rows[i]);
+        s.x.row(Eigen::Index(i - k)) = state.row(rows[i]);
+      }
+      (k < cut ? out.train : out.test).push_back(std::move(s));
+      k = end;
+    }
+    return out;
+  }
 
  private:
+  static physics::LipsonData load(const RunSettings& settings) {
+    return physics::load_lipson(settings.data_file.empty() ? default_data_path(kDataFile)
+                                                           : settings.data_file);
+  }
+
+  // The rows with a successor in their trial: the samples of forward_differences.
+  static std::vector<Eigen::Index> sample_rows(const physics::LipsonData& data) {
+    std::vector<Eigen::Index> rows;
+    for (Eigen::Index i = 0; i + 1 < data.rows(); ++i)
+      if (data.trial(i) == data.trial(i + 1)) rows.push_back(i);
+    return rows;
+  }
+
   static constexpr std::size_t kMinSamples = 10;
 
   // x = (angle, angular velocity); dx/dt by forward differences within each trial, the last
@@ -60,9 +93,7 @@ class RealPendulumTask : public FieldTask {
     HNN_TASKS_CHECK(data.columns.size() >= 2, "{}: expected angle and velocity columns, got {}",
                     data.path, data.columns.size());
     const Eigen::MatrixXd state = data.state().leftCols(2);
-    std::vector<Eigen::Index> rows;
-    for (Eigen::Index i = 0; i + 1 < data.rows(); ++i)
-      if (data.trial(i) == data.trial(i + 1)) rows.push_back(i);
+    const std::vector<Eigen::Index> rows = sample_rows(data);
     HNN_TASKS_CHECK(rows.size() >= kMinSamples,
                     "{}: {} samples (pairs of consecutive rows in one trial); at least {} are "
                     "needed to train and test",

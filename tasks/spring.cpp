@@ -21,8 +21,15 @@ class SpringTask : public FieldTask {
   // The `lean` preset (docs/speed_accuracy.md, chart 4): within the noise of 200-200.
   std::vector<int> lean_hidden() const override { return {16, 16}; }
   Dataset build_dataset(const RunSettings& settings) const override {
-    return oscillator_dataset(spring_, settings.seed,
-                              {.trajectories = 50, .points = 30, .t_end = 3.0});
+    return oscillator_dataset(spring_, settings.seed, sampling(settings));
+  }
+  std::vector<std::string> own_setting_names() const override { return {"sample_dt", "t_end"}; }
+  // The first half of the trajectories train (oscillator_dataset).
+  std::optional<SplitStretches> stretches(const RunSettings& settings,
+                                          const Dataset& data) const override {
+    const OscillatorSettings o = sampling(settings);
+    return SplitStretches{regular_stretches(data.train_x, o.points, o.t_end),
+                          regular_stretches(data.test_x, o.points, o.t_end)};
   }
   const physics::System& truth() const override { return spring_; }
   Batch rollout_states(const Dataset&, std::mt19937_64& rng) const override {
@@ -35,6 +42,11 @@ class SpringTask : public FieldTask {
   }
 
  private:
+  OscillatorSettings sampling(const RunSettings& settings) const {
+    return oscillator_settings(settings.task_settings,
+                               {.trajectories = 50, .points = 30, .t_end = 3.0}, name());
+  }
+
   physics::Spring spring_;
 };
 

@@ -12,7 +12,7 @@ std::function<void(nlohmann::json&, const std::string&)> add_data_options(CLI::A
   struct Values {
     std::vector<std::string> coords, momenta, velocities, derivatives;
     std::string time, trajectory, split, hamiltonian, loss, integrator;
-    double test_fraction = 0;
+    double test_fraction = 0, dt = 0;
     int horizon = 0;
   };
   auto v = std::make_shared<Values>();
@@ -40,20 +40,29 @@ std::function<void(nlohmann::json&, const std::string&)> add_data_options(CLI::A
   cmd.add_option("--hamiltonian", v->hamiltonian,
                  "A known H over the state's column names, for the energy metric")
       ->group(group);
+  const char* training = "Training through an integrator (every task that learns a field)";
   cmd.add_option("--loss", v->loss,
-                 "derivative (dx/dt targets) or rollout (from states alone: the model's field "
-                 "integrated --horizon steps, one per sampling interval)")
+                 "derivative (dx/dt targets, the default) or rollout (from states alone: the "
+                 "model's field integrated over --horizon sampling intervals)")
       ->check(CLI::IsMember(loss_names()))
-      ->group(group);
-  cmd.add_option("--horizon", v->horizon, "Steps of the rollout loss (default 1)")
+      ->group(training);
+  cmd.add_option("--horizon", v->horizon, "Sampling intervals per rollout window (default 1)")
       ->check(CLI::Range(1, 1000))
-      ->group(group);
-  cmd.add_option("--integrator", v->integrator, "The rollout loss's integrator: rk4")->group(group);
+      ->group(training);
+  cmd.add_option("--integrator", v->integrator,
+                 "The rollout loss's integrator: leapfrog, yoshida4, midpoint or rk4 (default)")
+      ->check(CLI::IsMember({"leapfrog", "yoshida4", "midpoint", "rk4"}))
+      ->group(training);
+  cmd.add_option("--dt", v->dt,
+                 "The rollout loss's step (default: the sampling interval; it must divide it)")
+      ->check(positive_real())
+      ->group(training);
   // Writes the options given into the task's settings; refuses them for another task.
   return [v, &cmd](nlohmann::json& settings, const std::string& task) {
-    const auto put = [&](const char* option, const char* key, const nlohmann::json& value) {
+    const auto put = [&](const char* option, const char* key, const nlohmann::json& value,
+                         bool any_task = false) {
       if (cmd.get_option(option)->count() == 0) return;
-      if (task != "data") {
+      if (task != "data" && !any_task) {
         throw std::invalid_argument(
             fmt::format("{} applies to the data task only, not to '{}'", option, task));
       }
@@ -68,9 +77,10 @@ std::function<void(nlohmann::json&, const std::string&)> add_data_options(CLI::A
     put("--split", "split", v->split);
     put("--test-fraction", "test_fraction", v->test_fraction);
     put("--hamiltonian", "hamiltonian", v->hamiltonian);
-    put("--loss", "loss", v->loss);
-    put("--horizon", "horizon", v->horizon);
-    put("--integrator", "integrator", v->integrator);
+    put("--loss", "loss", v->loss, true);
+    put("--horizon", "horizon", v->horizon, true);
+    put("--integrator", "integrator", v->integrator, true);
+    put("--dt", "dt", v->dt, true);
   };
 }
 

@@ -67,11 +67,11 @@ void train_until_done_or_stopped(tasks::RunOptions o) {
 // the result may be given again.
 tasks::RunOptions resumed_options(const CLI::App& cmd, const std::string& dir, bool quiet) {
   for (const char* name :
-       {"task",          "--model", "--steps",      "--seed",      "--dtype",
-        "--preset",      "--batch", "--hidden",     "--lr",        "--data",
-        "--settings",    "--out",   "--coords",     "--momenta",   "--velocities",
-        "--derivatives", "--time",  "--trajectory", "--split",     "--test-fraction",
-        "--hamiltonian", "--loss",  "--horizon",    "--integrator"}) {
+       {"task",          "--model", "--steps",      "--seed",       "--dtype",
+        "--preset",      "--batch", "--hidden",     "--lr",         "--data",
+        "--settings",    "--out",   "--coords",     "--momenta",    "--velocities",
+        "--derivatives", "--time",  "--trajectory", "--split",      "--test-fraction",
+        "--hamiltonian", "--loss",  "--horizon",    "--integrator", "--dt"}) {
     if (cmd.get_option(name)->count() > 0) {
       throw std::invalid_argument(fmt::format(
           "{} cannot be combined with --resume: a resumed run keeps its own settings", name));

@@ -1,6 +1,7 @@
 #include "tasks/train/rollout_objective.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "autodiff/ops.h"
 #include "autodiff/tape.h"
@@ -15,16 +16,70 @@ namespace {
 // Curves evaluate at most this many windows of each split.
 constexpr Eigen::Index kCurveWindows = 2000;
 
-template <typename T>
-ad::Var<T> constant_rows(const Batch& m, const std::vector<Eigen::Index>* rows) {
-  if (rows == nullptr) return ad::Var<T>::constant(m.cast<T>());
-  ad::Matrix<T> out(Eigen::Index(rows->size()), m.cols());
-  for (std::size_t i = 0; i < rows->size(); ++i)
-    out.row(Eigen::Index(i)) = m.row((*rows)[i]).cast<T>();
-  return ad::Var<T>::constant(out);
-}
+// Relative slack of "a near-multiple of dt".
+constexpr double kMultipleSlack = 0.01;
 
 }  // namespace
+
+nlohmann::json RolloutLossConfig::to_json() const {
+  if (!rollout) return {{"loss", "derivative"}};
+  return {{"loss", "rollout"},
+          {"integrator", std::string(to_string(integrator))},
+          {"horizon", horizon},
+          {"dt", dt > 0 ? nlohmann::json(dt) : nlohmann::json("sampling interval")}};
+}
+
+const std::vector<std::string>& rollout_setting_names() {
+  static const std::vector<std::string> names = {"loss", "horizon", "integrator", "dt"};
+  return names;
+}
+
+RolloutLossConfig rollout_loss_config(const nlohmann::json& s, const std::string& task) {
+  RolloutLossConfig c;
+  try {
+    const std::string loss = s.value("loss", std::string("derivative"));
+    HNN_TASKS_CHECK(loss == "derivative" || loss == "rollout",
+                    "{}: loss '{}' is not one of derivative, rollout", task, loss);
+    c.rollout = loss == "rollout";
+    if (s.contains("horizon")) {
+      HNN_TASKS_CHECK(s["horizon"].is_number_integer(), "{}: horizon must be an integer, got {}",
+                      task, s["horizon"].dump());
+      c.horizon = s["horizon"].get<int>();
+    }
+    if (s.contains("integrator"))
+      c.integrator = parse_rollout_integrator(s["integrator"].get<std::string>());
+    if (s.contains("dt")) c.dt = s["dt"].get<double>();
+  } catch (const nlohmann::json::exception& e) {
+    throw Error(fmt::format("{}: bad rollout-loss settings {}: {}", task, s.dump(), e.what()));
+  }
+  HNN_TASKS_CHECK(
+      c.rollout || (!s.contains("horizon") && !s.contains("integrator") && !s.contains("dt")),
+      "{}: --horizon, --integrator and --dt apply to the rollout loss only (add --loss "
+      "rollout)",
+      task);
+  HNN_TASKS_CHECK(c.horizon >= 1, "{}: horizon must be at least 1 step, got {}", task, c.horizon);
+  HNN_TASKS_CHECK(!s.contains("dt") || (c.dt > 0 && std::isfinite(c.dt)),
+                  "{}: --dt must be a positive step, got {}", task, c.dt);
+  return c;
+}
+
+int rollout_substeps(const RolloutWindows& w, double dt) {
+  if (dt <= 0) return 1;
+  double shortest = INFINITY, longest = 0;
+  for (const Batch& step : w.step) {
+    shortest = std::min(shortest, step.minCoeff());
+    longest = std::max(longest, step.maxCoeff());
+  }
+  const double steps = std::round(longest / dt);
+  const bool fits = steps >= 1 && std::abs(shortest / dt - steps) <= kMultipleSlack * steps &&
+                    std::abs(longest / dt - steps) <= kMultipleSlack * steps;
+  HNN_TASKS_CHECK(fits,
+                  "--dt {} does not divide the sampling interval ({}{}) into whole steps: use the "
+                  "interval divided by a whole number",
+                  dt, shortest,
+                  longest > shortest * (1 + 1e-9) ? fmt::format(" to {}", longest) : std::string());
+  return int(steps);
+}
 
 RolloutWindows rollout_windows(const std::vector<Stretch>& stretches, int horizon) {
   HNN_TASKS_CHECK(horizon >= 1, "the rollout horizon must be at least 1 step, got {}", horizon);
@@ -58,28 +113,43 @@ RolloutWindows rollout_windows(const std::vector<Stretch>& stretches, int horizo
 template <typename T>
 RolloutObjective<T>::RolloutObjective(nn::DynamicsModel<T>& model, RolloutWindows train,
                                       RolloutWindows test, Eigen::Index batch_size,
-                                      const nn::AdamOptions& adam, std::uint64_t seed)
+                                      const nn::AdamOptions& adam, std::uint64_t seed,
+                                      RolloutIntegrator integrator, int substeps)
     : model_(model),
       train_(std::move(train)),
       test_(std::move(test)),
       adam_(adam),
-      sampler_(train_.count(), batch_size, RowSampler::Draw::kWithReplacement, seed) {}
+      sampler_(train_.count(), batch_size, RowSampler::Draw::kWithReplacement, seed),
+      integrator_(integrator),
+      substeps_(substeps),
+      scratch_(1 + 2 * train_.next.size()) {}
 
-// One RK4 step per sampling interval, each row with its own step length.
+template <typename T>
+ad::Var<T> RolloutObjective<T>::constant_rows(const Batch& m, const std::vector<Eigen::Index>* rows,
+                                              double scale, std::size_t slot) const {
+  ad::Matrix<T>& out = scratch_[slot];
+  const Eigen::Index n = rows == nullptr ? m.rows() : Eigen::Index(rows->size());
+  out.resize(n, m.cols());  // no allocation once the size has been seen
+  if (rows == nullptr) {
+    out = (m * scale).template cast<T>();
+  } else {
+    for (Eigen::Index i = 0; i < n; ++i)
+      out.row(i) = (m.row((*rows)[std::size_t(i)]) * scale).template cast<T>();
+  }
+  return ad::Var<T>::constant(out);
+}
+
+// `substeps_` steps of the integrator per sampling interval, each row with its own length.
 template <typename T>
 ad::Var<T> RolloutObjective<T>::loss(const RolloutWindows& w,
                                      const std::vector<Eigen::Index>* rows) const {
-  ad::Var<T> x = constant_rows<T>(w.start, rows);
+  if (scratch_.size() < 1 + 2 * w.next.size()) scratch_.resize(1 + 2 * w.next.size());
+  ad::Var<T> x = constant_rows(w.start, rows, 1.0, 0);
   ad::Var<T> total;
   for (std::size_t j = 0; j < w.next.size(); ++j) {
-    const ad::Var<T> h = constant_rows<T>(w.step[j], rows);
-    const ad::Var<T> half = h * T(0.5);
-    const ad::Var<T> k1 = model_.time_derivative(x);
-    const ad::Var<T> k2 = model_.time_derivative(x + half * k1);
-    const ad::Var<T> k3 = model_.time_derivative(x + half * k2);
-    const ad::Var<T> k4 = model_.time_derivative(x + h * k3);
-    x = x + (h * T(1.0 / 6.0)) * (k1 + T(2) * k2 + T(2) * k3 + k4);
-    const ad::Var<T> step_loss = nn::mse(x, constant_rows<T>(w.next[j], rows));
+    const ad::Var<T> h = constant_rows(w.step[j], rows, 1.0 / substeps_, 1 + 2 * j);
+    for (int s = 0; s < substeps_; ++s) x = integrator_step(model_, x, h, integrator_);
+    const ad::Var<T> step_loss = nn::mse(x, constant_rows(w.next[j], rows, 1.0, 2 + 2 * j));
     total = total.defined() ? total + step_loss : step_loss;
   }
   return total * T(1.0 / double(w.next.size()));

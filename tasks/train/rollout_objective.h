@@ -1,16 +1,20 @@
 #pragma once
 // Training through an integrator (Chen et al. 2020, "Symplectic Recurrent Neural Networks"):
-// from states alone, the model's field is integrated `horizon` steps of RK4 from a measured
-// state, one step per sampling interval, and every predicted state is compared with the
-// measured one. The loss differentiates through the steps (and, for an HNN, through its field,
-// a second-order path), so no dx/dt targets are needed.
+// from states alone, the model's field is integrated `horizon` sampling intervals from a measured
+// state (rk4, leapfrog, yoshida4 or the implicit midpoint; one step per interval, or
+// interval / dt sub-steps), and every predicted state is compared with the measured one. The
+// loss differentiates through the steps (and, for an HNN, through its field, a second-order
+// path), so no dx/dt targets are needed.
 
 #include <cstdint>
+#include <nlohmann/json.hpp>
+#include <string>
 #include <vector>
 
 #include "nn/dynamics.h"
 #include "tasks/data/dataset.h"
 #include "tasks/train/objective.h"
+#include "tasks/train/rollout_step.h"
 
 namespace hnn::tasks {
 
@@ -32,12 +36,35 @@ struct RolloutWindows {
 /// Throws Error when no stretch has horizon + 1 points (naming the longest) or horizon < 1.
 RolloutWindows rollout_windows(const std::vector<Stretch>& stretches, int horizon);
 
+/// How a run trains: its task settings "loss" (derivative or rollout), "horizon", "integrator"
+/// and "dt", the same keys on every task that learns a field from states.
+struct RolloutLossConfig {
+  bool rollout = false;  ///< "loss": "rollout" (else dx/dt targets)
+  int horizon = 1;       ///< sampling intervals per window
+  RolloutIntegrator integrator = RolloutIntegrator::kRk4;
+  double dt = 0;  ///< the step; 0: one step per sampling interval
+
+  /// {"loss", "integrator", "horizon", "dt"} as metrics.json reports them.
+  nlohmann::json to_json() const;
+};
+
+/// The keys above. Throws Error (naming `task`) on a bad value, and on horizon, integrator or
+/// dt without "loss": "rollout".
+RolloutLossConfig rollout_loss_config(const nlohmann::json& settings, const std::string& task);
+const std::vector<std::string>& rollout_setting_names();
+
+/// Sub-steps per sampling interval: 1 for dt 0, else round(interval / dt), the same for every
+/// interval of the windows within 1%. Throws Error naming dt and the intervals otherwise.
+int rollout_substeps(const RolloutWindows& windows, double dt);
+
 template <typename T>
 class RolloutObjective : public Objective<T> {
  public:
   /// `batch_size` 0: every window. Test windows (may be empty) give the curve's test loss.
+  /// Each interval is integrated in `substeps` equal steps of `integrator`.
   RolloutObjective(nn::DynamicsModel<T>& model, RolloutWindows train, RolloutWindows test,
-                   Eigen::Index batch_size, const nn::AdamOptions& adam, std::uint64_t seed);
+                   Eigen::Index batch_size, const nn::AdamOptions& adam, std::uint64_t seed,
+                   RolloutIntegrator integrator = RolloutIntegrator::kRk4, int substeps = 1);
 
   nn::Module<T>& model() override { return model_; }
   std::vector<ParameterGroup<T>> parameter_groups() const override {
@@ -52,10 +79,18 @@ class RolloutObjective : public Objective<T> {
   // The mean squared error of the predicted states over every step of `rows` of `w`.
   ad::Var<T> loss(const RolloutWindows& w, const std::vector<Eigen::Index>* rows) const;
 
+  // The rows of `m` picked by `rows` (all with nullptr), scaled, as a tape constant; gathered in
+  // scratch that persists, so a warmed-up step allocates nothing.
+  ad::Var<T> constant_rows(const Batch& m, const std::vector<Eigen::Index>* rows, double scale,
+                           std::size_t slot) const;
+
   nn::DynamicsModel<T>& model_;
   RolloutWindows train_, test_;
   nn::AdamOptions adam_;
   RowSampler sampler_;
+  RolloutIntegrator integrator_;
+  int substeps_;
+  mutable std::vector<ad::Matrix<T>> scratch_;
 };
 
 }  // namespace hnn::tasks

@@ -54,7 +54,8 @@ std::vector<BadOption> bad_train_options() {
        "task 'spring' does not read a data file (--data applies to measured-data tasks such as "
        "real-pendulum)"},
       {{"train", "spring", "--settings", "{\"trials\": 20}"},
-       "task 'spring' has no settings of its own, got {\"trials\":20}"},
+       "task 'spring' has no setting 'trials' (known: loss, horizon, integrator, dt, sample_dt, "
+       "t_end)"},
       {{"train", "pixel-pendulum", "--settings", "[20]"},
        "--settings must be a JSON object like '{\"trials\": 20}', got '[20]'"},
       {{"train", "pixel-pendulum", "--settings", "{\"trials\": 1}"},

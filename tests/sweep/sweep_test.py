@@ -105,7 +105,7 @@ class SpecErrors(SweepCase):
         ("task: [spring]\nseed: [0, x]\n", "yaml", "key 'seed': expected an integer"),
         ("task: [spring]\n  seed: [0\n", "yaml", "not valid YAML"),
         ('{"task": ["spring"], "settings": [{"trials": 3}]}', "json",
-         "run 'spring/hnn/settings=trials-3': task 'spring' has no settings"),
+         "run 'spring/hnn/settings=trials-3': task 'spring' has no setting 'trials'"),
     ]
 
     def test_each_bad_spec_is_one_line_naming_its_key(self):

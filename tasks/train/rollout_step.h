@@ -1,0 +1,61 @@
+#pragma once
+// One step of an integrator through a model's field x' = f(x), recorded on the tape so that a
+// loss on the states it reaches differentiates through it (and, for an HNN, through the field:
+// a second-order path). The state is x = (q, p), q the first half of the columns; a model only
+// supplies time_derivative(x), so every method works for hnn, baseline and dhnn alike.
+//
+// - rk4: the classical Runge-Kutta method, order 4, not symplectic.
+// - leapfrog: kick-drift-kick on the field's p-part and q-part,
+//     p' = p + h/2 f_p(q, p);  q1 = q + h f_q(q, p');  p1 = p' + h/2 f_p(q1, p').
+//   For a separable H (f_p depends on q alone, f_q on p alone) it is Stormer-Verlet: symplectic,
+//   order 2. For a field that is not separable (a learned H(q, p) in general) it is an explicit
+//   method of order 1 only: the kicks miss the h^2/2 (df_p/dp) f_p term and the drift the
+//   h^2/2 (df_q/dq) f_q term (tests/tasks/rollout_integrators_test.cpp measures both orders).
+// - yoshida4: Yoshida's triple jump of leapfrog (steps w1 h, w0 h, w1 h), order 4 for a
+//   separable H, symplectic there.
+// - midpoint: the implicit midpoint rule x1 = x0 + h f((x0 + x1)/2), order 2, symplectic for ANY
+//   H, separable or not. Solved off the tape (Note [Midpoint on the tape]).
+
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "autodiff/var.h"
+#include "nn/dynamics.h"
+
+namespace hnn::tasks {
+
+enum class RolloutIntegrator { kRk4, kLeapfrog, kYoshida4, kMidpoint };
+
+std::string_view to_string(RolloutIntegrator integrator);
+/// Throws Error naming the four valid names.
+RolloutIntegrator parse_rollout_integrator(std::string_view name);
+std::vector<std::string> rollout_integrator_names();
+
+/// The implicit midpoint's solve: converged when max |dx| / (1 + |x|) <= tolerance.
+struct MidpointSolve {
+  double tolerance = 0;  ///< 0: 1e-12 in double, 1e-5 in float
+  int max_iterations = 50;
+};
+
+/// Midpoint iterations used so far on this thread (tests and reports).
+long midpoint_iterations();
+
+/// One step of size h (a column: one length per row) from x, on the tape unless grad mode is
+/// off. Throws Error when the midpoint solve does not converge, naming the row and residual.
+template <typename T>
+ad::Var<T> integrator_step(const nn::DynamicsModel<T>& model, const ad::Var<T>& x,
+                           const ad::Var<T>& h, RolloutIntegrator method,
+                           const MidpointSolve& solve = {});
+
+/// The converged implicit-midpoint step as plain values, off the tape: x1 with
+/// x1 = x0 + h f((x0 + x1)/2) for every row (h a column). The map the on-tape step differentiates.
+template <typename T>
+ad::Matrix<T> midpoint_solve(const nn::DynamicsModel<T>& model, const ad::Matrix<T>& x0,
+                             const ad::Matrix<T>& h, const MidpointSolve& solve = {});
+
+/// d f_r / d x_r for every row r of x, flattened row-major (R x n^2), as plain values.
+template <typename T>
+ad::Matrix<T> field_row_jacobian(const nn::DynamicsModel<T>& model, const ad::Matrix<T>& x);
+
+}  // namespace hnn::tasks
