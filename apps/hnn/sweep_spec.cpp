@@ -149,7 +149,9 @@ SweepRun build_run(const std::vector<std::pair<const KeyInfo*, ordered_json>>& c
     for (std::string& a : arg_values(key, v)) run.args.push_back(std::move(a));
     if (key.name != "model") tags.push_back(fmt::format("{}={}", key.name, name_value(key, v)));
     if (!key.data_setting.empty()) {
-      if (o.task != "data")
+      // The rollout loss's keys apply to every task that learns a field (its own check decides).
+      const bool any_task = key.name == "loss" || key.name == "horizon" || key.name == "integrator";
+      if (o.task != "data" && !any_task)
         throw bad(
             fmt::format("key '{}': applies to the data task only, not to '{}'", key.name, o.task));
       data_settings[std::string(key.data_setting)] = v;
