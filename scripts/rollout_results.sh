@@ -21,11 +21,16 @@ threebody_steps=${HNN_ROLLOUT_THREEBODY_STEPS:-5000}
 midpoint_steps=${HNN_ROLLOUT_MIDPOINT_STEPS:-3000}
 mkdir -p "$out"
 
-train() {  # train FOLDER ARGS...: skipped when FOLDER already holds a finished run
+train() {  # train FOLDER ARGS...: skipped when FOLDER already holds a finished run; a run that
+  # fails (a midpoint solve that does not converge, say) leaves its one-line error in FOLDER.err
   local dir=$out/runs/$1
   shift
-  [[ -f $dir/metrics.json ]] && return 0
-  "$hnn" train "$@" --quiet --out "$dir" >/dev/null
+  [[ -f $dir/metrics.json || -f $dir.err ]] && return 0
+  if ! "$hnn" train "$@" --quiet --out "$dir" >/dev/null 2>"$dir.log"; then
+    tail -1 "$dir.log" >"$dir.err"
+    rm -rf "$dir"
+  fi
+  rm -f "$dir.log"
 }
 
 for seed in $(seq 0 $((seeds - 1))); do
@@ -63,14 +68,17 @@ def stats(v):
     m = sum(v) / len(v)
     se = math.sqrt(sum((x - m) ** 2 for x in v) / (len(v) - 1) / len(v)) if len(v) > 1 else math.nan
     return m, se, len(v)
-def cell(v, digits=3):
+def cell(v, digits=3, failed=0):
     m, se, n = stats(v)
-    if n == 0: return "n/a"
-    return f"{m:.{digits}g} ± {se:.1g}" if math.isfinite(se) else f"{m:.{digits}g}"
+    note = f" ({failed} failed)" if failed else ""
+    if n == 0: return "failed" if failed else "n/a"
+    return (f"{m:.{digits}g} ± {se:.1g}" if math.isfinite(se) else f"{m:.{digits}g}") + note
 def runs(task, kind):
     return [json.loads((d / "metrics.json").read_text())
             for d in sorted((out / "runs" / task / kind).glob("seed-*"))
             if (d / "metrics.json").exists()]
+def failures(task, kind):
+    return sorted((out / "runs" / task / kind).glob("seed-*.err"))
 
 print("## Three-body at dt = 1 (the SRNN paper's setup)\n")
 print("L2 position error: per test trajectory (32), the Euclidean distance of each body's "
@@ -105,10 +113,15 @@ print("Held-out error along the test trajectories from their first (noisy) state
 print("| data | derivative | rollout, leapfrog | rollout, midpoint | truth by leapfrog |")
 print("| --- | --- | --- | --- | --- |")
 for task in ["spring-dt0.5", "spring-dt1.0", "pendulum-dt0.5", "pendulum-dt1.0", "real-pendulum"]:
-    cells = [cell([x["stretch_state_mse"] for x in runs(task, k)])
+    cells = [cell([x["stretch_state_mse"] for x in runs(task, k)], failed=len(failures(task, k)))
              for k in ("derivative", "leapfrog", "midpoint")]
     t = runs(task, "derivative")
     cells.append(cell([x["truth_leapfrog_state_mse"] for x in t]))
     print(f"| {task} | " + " | ".join(cells) + " |")
+errors = sorted((out / "runs").glob("*/*/seed-*.err"))
+if errors:
+    print("\nFailed runs:\n")
+    for e in errors:
+        print(f"- {e.relative_to(out / 'runs').with_suffix('')}: {e.read_text().strip()}")
 PY
 cat "$out/results.md"
