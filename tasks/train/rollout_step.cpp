@@ -92,6 +92,31 @@ Matrix<T> solve_rows(const Matrix<T>& a, const Matrix<T>& b) {
   return ad::batched_solve(Var<T>::constant(a), Var<T>::constant(b)).value();
 }
 
+// A row whose residual grew (Newton from a poor guess or with a stale Jacobian, a diverging
+// fixed-point iteration: h L / 2 > 1) goes back to its last accepted iterate, and its Newton
+// steps are halved; a row that improved is accepted and its steps doubled back towards full.
+// Not near the rounding floor, where residuals wander. True when some row went back.
+template <typename T>
+bool backtrack_rows(const Matrix<T>& residual, T tolerance, int it, Matrix<T>& x1,
+                    Matrix<T>& accepted, Eigen::VectorXd& accepted_norm,
+                    Eigen::Matrix<T, Eigen::Dynamic, 1>& damping) {
+  bool backtracked = false;
+  for (Eigen::Index r = 0; r < x1.rows(); ++r) {
+    const double norm =
+        double((residual.row(r).array().abs() / (T(1) + x1.row(r).array().abs())).maxCoeff());
+    if (norm > accepted_norm(r) && norm > 100 * double(tolerance)) {
+      x1.row(r) = accepted.row(r);
+      damping(r) *= T(0.5);
+      backtracked = true;
+    } else {
+      if (it > 0) damping(r) = std::min(T(1), T(2) * damping(r));
+      accepted.row(r) = x1.row(r);
+      accepted_norm(r) = norm;
+    }
+  }
+  return backtracked;
+}
+
 // Note [Midpoint on the tape]
 // x1* solves x1 = x0 + h f((x0 + x1)/2) off the tape. On the tape goes one Newton correction
 // from it, x1 = x1* - A^-1 F with F = x1* - x0 - h f(m), m = (x0 + x1*)/2, x1* a constant and
@@ -161,7 +186,8 @@ Matrix<T> midpoint_solve(const nn::DynamicsModel<T>& model, const Matrix<T>& x0,
   Matrix<T> x1 = step(model.field(x0));  // explicit Euler: the first guess
   Matrix<T> accepted = x1;  // per row, the last iterate that did not raise its residual
   Eigen::VectorXd accepted_norm = Eigen::VectorXd::Constant(x0.rows(), INFINITY);
-  Eigen::Matrix<T, Eigen::Dynamic, 1> damping = Eigen::Matrix<T, Eigen::Dynamic, 1>::Ones(x0.rows());
+  Eigen::Matrix<T, Eigen::Dynamic, 1> damping =
+      Eigen::Matrix<T, Eigen::Dynamic, 1>::Ones(x0.rows());
   double previous = std::numeric_limits<double>::infinity();
   bool newton = false;
   Matrix<T> a;  // A of the chord iterations, refreshed when they slow down
@@ -174,24 +200,8 @@ Matrix<T> midpoint_solve(const nn::DynamicsModel<T>& model, const Matrix<T>& x0,
     if (worst.first <= double(tolerance)) return x1;
     if (it == solve.max_iterations) break;
     ++t_midpoint_iterations;
-    // A row whose residual grew (Newton from a poor guess or with a stale Jacobian, a diverging
-    // fixed-point iteration: h L / 2 > 1) goes back to its last accepted iterate and takes half
-    // the Newton step from there, with a fresh Jacobian. Not near the rounding floor, where
-    // residuals wander.
-    bool backtracked = false;
-    for (Eigen::Index r = 0; r < x1.rows(); ++r) {
-      const double norm =
-          double((residual.row(r).array().abs() / (T(1) + x1.row(r).array().abs())).maxCoeff());
-      if (norm > accepted_norm(r) && norm > 100 * double(tolerance)) {
-        x1.row(r) = accepted.row(r);
-        damping(r) *= T(0.5);
-        backtracked = true;
-      } else {
-        if (it > 0) damping(r) = std::min(T(1), T(2) * damping(r));  // back to full steps
-        accepted.row(r) = x1.row(r);
-        accepted_norm(r) = norm;
-      }
-    }
+    const bool backtracked =
+        backtrack_rows<T>(residual, tolerance, it, x1, accepted, accepted_norm, damping);
     if (backtracked) {
       newton = true;
       a.resize(0, 0);
