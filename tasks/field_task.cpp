@@ -28,9 +28,12 @@ constexpr std::size_t kMaxStretches = 200;
 // States at a stretch's times from its first state (times x dim per stretch, batched).
 using Predictor = std::function<std::vector<Batch>(const Batch& x0, const Eigen::VectorXd& t)>;
 
-// Every stretch predicted from its first state: one batched call when the stretches share their
-// times (the simulated tasks), else one call per stretch. Result: one path (points x dim) each.
-std::vector<Batch> predict_paths(const std::vector<Stretch>& stretches, const Predictor& predict) {
+// One path (points x dim) per stretch, predicted from its first state: one batched call when the
+// stretches share their times (the simulated tasks), else (or when the batch fails) one call per
+// stretch. A stretch whose prediction fails (a learned field that blows up) gets a NaN path and
+// counts in `failures`.
+std::vector<Batch> predict_paths(const std::vector<Stretch>& stretches, const Predictor& predict,
+                                 int& failures) {
   const Eigen::VectorXd t0 = stretches[0].t.array() - stretches[0].t(0);
   const bool shared = std::all_of(stretches.begin(), stretches.end(), [&](const Stretch& s) {
     return s.t.size() == t0.size() && ((s.t.array() - s.t(0)) - t0.array()).abs().maxCoeff() < 1e-9;
@@ -40,27 +43,36 @@ std::vector<Batch> predict_paths(const std::vector<Stretch>& stretches, const Pr
     Batch x0(Eigen::Index(stretches.size()), stretches[0].x.cols());
     for (std::size_t i = 0; i < stretches.size(); ++i)
       x0.row(Eigen::Index(i)) = stretches[i].x.row(0);
-    const std::vector<Batch> states = predict(x0, t0);
-    for (Eigen::Index i = 0; i < x0.rows(); ++i) {
-      Batch path(t0.size(), x0.cols());
-      for (Eigen::Index k = 0; k < t0.size(); ++k) path.row(k) = states[std::size_t(k)].row(i);
-      paths.push_back(std::move(path));
+    try {
+      const std::vector<Batch> states = predict(x0, t0);
+      for (Eigen::Index i = 0; i < x0.rows(); ++i) {
+        Batch path(t0.size(), x0.cols());
+        for (Eigen::Index k = 0; k < t0.size(); ++k) path.row(k) = states[std::size_t(k)].row(i);
+        paths.push_back(std::move(path));
+      }
+      return paths;
+    } catch (const std::exception&) {
+      paths.clear();  // one at a time below, to keep the stretches that do integrate
     }
-    return paths;
   }
   for (const Stretch& s : stretches) {
-    const std::vector<Batch> states = predict(s.x.topRows(1), s.t.array() - s.t(0));
-    Batch path(s.t.size(), s.x.cols());
-    for (Eigen::Index k = 0; k < s.t.size(); ++k) path.row(k) = states[std::size_t(k)].row(0);
+    Batch path = Batch::Constant(s.t.size(), s.x.cols(), NAN);
+    try {
+      const std::vector<Batch> states = predict(s.x.topRows(1), s.t.array() - s.t(0));
+      for (Eigen::Index k = 0; k < s.t.size(); ++k) path.row(k) = states[std::size_t(k)].row(0);
+    } catch (const std::exception&) {
+      ++failures;
+    }
     paths.push_back(std::move(path));
   }
   return paths;
 }
 
-// Mean, standard deviation and standard error of per-stretch values.
-json spread(const std::string& name, const std::vector<double>& v) {
+// Mean, standard deviation and standard error of the finite per-stretch values.
+json spread(const std::string& name, std::vector<double> v) {
+  std::erase_if(v, [](double x) { return !std::isfinite(x); });
   const double n = double(v.size());
-  double mean = 0, var = 0;
+  double mean = v.empty() ? NAN : 0, var = 0;
   for (double x : v) mean += x / n;
   for (double x : v) var += (x - mean) * (x - mean) / std::max(1.0, n - 1);
   return {{name, number(mean)},
@@ -78,6 +90,7 @@ json stretch_errors(const std::string& prefix, const std::vector<Stretch>& stret
     const Batch e = paths[i] - stretches[i].x;
     const Eigen::Index n = e.cols() / 2, bodies = n / per_body;
     mse.push_back(e.rows() > 1 ? e.bottomRows(e.rows() - 1).array().square().mean() : 0.0);
+    if (!std::isfinite(mse.back())) mse.back() = NAN;
     double sum = 0;
     for (Eigen::Index k = 0; k < e.rows(); ++k)
       for (Eigen::Index b = 0; b < bodies; ++b)
@@ -170,16 +183,20 @@ class FieldRun : public FieldModelRun {
                               stretches_->test.begin() +
                                   std::ptrdiff_t(std::min(kMaxStretches, stretches_->test.size())));
     const int per_body = task_.coordinates_per_body();
-    json m = stretch_errors("stretch_", test, predict_paths(test, model_predictor()), per_body);
+    int failures = 0, train_failures = 0, truth_failures = 0;
+    json m = stretch_errors("stretch_", test, predict_paths(test, model_predictor(), failures),
+                            per_body);
+    m["stretch_failures"] = failures;
     // The same on training stretches: the gap to the test figure is what generalisation costs.
     std::vector<Stretch> train(
         stretches_->train.begin(),
         stretches_->train.begin() +
             std::ptrdiff_t(std::min(kMaxStretches, stretches_->train.size())));
-    const json fit =
-        stretch_errors("train_stretch_", train, predict_paths(train, model_predictor()), per_body);
+    const json fit = stretch_errors(
+        "train_stretch_", train, predict_paths(train, model_predictor(), train_failures), per_body);
     m["train_stretch_position_error"] = fit["train_stretch_position_error"];
     m["train_stretch_state_mse"] = fit["train_stretch_state_mse"];
+    m["train_stretch_failures"] = train_failures;
     m["stretch_predictor"] = loss_.rollout ? fmt::format("{}, {} step(s) per interval",
                                                          to_string(loss_.integrator), substeps_)
                                            : std::string("dopri5 (rtol 1e-9)");
@@ -190,18 +207,21 @@ class FieldRun : public FieldModelRun {
       return integrator->integrate(task_.truth().field(), x0, {t.data(), t.data() + t.size()})
           .states;
     };
-    const json truth =
-        stretch_errors("truth_leapfrog_", test, predict_paths(test, leapfrog), per_body);
+    const json truth = stretch_errors("truth_leapfrog_", test,
+                                      predict_paths(test, leapfrog, truth_failures), per_body);
     m["truth_leapfrog_position_error"] = truth["truth_leapfrog_position_error"];
     m["truth_leapfrog_position_error_std"] = truth["truth_leapfrog_position_error_std"];
     m["truth_leapfrog_state_mse"] = truth["truth_leapfrog_state_mse"];
+    m["truth_leapfrog_failures"] = truth_failures;
     return m;
   }
 
   Predictor model_predictor() const {
     if (!loss_.rollout) {
       return [this](const Batch& x0, const Eigen::VectorXd& t) {
-        const auto integrator = physics::make_integrator("dopri5", {.rtol = 1e-9, .atol = 1e-12});
+        // max_steps as the energy rollouts': a stiff learned field fails here, not hangs.
+        const auto integrator =
+            physics::make_integrator("dopri5", {.rtol = 1e-9, .atol = 1e-12, .max_steps = 100'000});
         return integrator
             ->integrate(learned_field(dynamics()).field, x0, {t.data(), t.data() + t.size()})
             .states;

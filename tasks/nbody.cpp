@@ -101,12 +101,20 @@ class NBodyTask : public FieldTask {
   Dataset build_dataset(const RunSettings& settings) const override {
     std::mt19937_64 rng(settings.seed);
     if (srnn_setup(settings, name())) {
-      Dataset d;
-      const Batch test0 = srnn_states(system_, kSrnnTest, rng);
       const int n = settings.task_settings.value("train_trajectories", kSrnnTrain);
       HNN_TASKS_CHECK(n >= 1 && n <= 100000,
                       "three-body: train_trajectories must be 1..100000, got {}", n);
-      const Batch train0 = srnn_states(system_, n, rng);
+      // one_draw: train and test from one draw (one set of velocity factors), to measure what
+      // their separate draws (a shift between the sets) cost.
+      Batch test0, train0;
+      if (settings.task_settings.value("one_draw", false)) {
+        const Batch all = srnn_states(system_, kSrnnTest + n, rng);
+        test0 = all.topRows(kSrnnTest);
+        train0 = all.bottomRows(n);
+      } else {
+        test0 = srnn_states(system_, kSrnnTest, rng);
+        train0 = srnn_states(system_, n, rng);
+      }
       const TrajectorySamples test =
           sample_trajectories(system_, test0, kSrnnTEnd, kSrnnPoints, 1e-10);
       const TrajectorySamples train =
@@ -123,7 +131,7 @@ class NBodyTask : public FieldTask {
     return d;
   }
   std::vector<std::string> own_setting_names() const override {
-    if (settings_.bodies == 3) return {"setup", "train_trajectories"};
+    if (settings_.bodies == 3) return {"setup", "train_trajectories", "one_draw"};
     return {};
   }
   int coordinates_per_body() const override { return 2; }

@@ -92,6 +92,31 @@ Matrix<T> solve_rows(const Matrix<T>& a, const Matrix<T>& b) {
   return ad::batched_solve(Var<T>::constant(a), Var<T>::constant(b)).value();
 }
 
+// A row whose residual grew (Newton from a poor guess or with a stale Jacobian, a diverging
+// fixed-point iteration: h L / 2 > 1) goes back to its last accepted iterate, and its Newton
+// steps are halved; a row that improved is accepted and its steps doubled back towards full.
+// Not near the rounding floor, where residuals wander. True when some row went back.
+template <typename T>
+bool backtrack_rows(const Matrix<T>& residual, T tolerance, int it, Matrix<T>& x1,
+                    Matrix<T>& accepted, Eigen::VectorXd& accepted_norm,
+                    Eigen::Matrix<T, Eigen::Dynamic, 1>& damping) {
+  bool backtracked = false;
+  for (Eigen::Index r = 0; r < x1.rows(); ++r) {
+    const double norm =
+        double((residual.row(r).array().abs() / (T(1) + x1.row(r).array().abs())).maxCoeff());
+    if (norm > accepted_norm(r) && norm > 100 * double(tolerance)) {
+      x1.row(r) = accepted.row(r);
+      damping(r) *= T(0.5);
+      backtracked = true;
+    } else {
+      if (it > 0) damping(r) = std::min(T(1), T(2) * damping(r));
+      accepted.row(r) = x1.row(r);
+      accepted_norm(r) = norm;
+    }
+  }
+  return backtracked;
+}
+
 // Note [Midpoint on the tape]
 // x1* solves x1 = x0 + h f((x0 + x1)/2) off the tape. On the tape goes one Newton correction
 // from it, x1 = x1* - A^-1 F with F = x1* - x0 - h f(m), m = (x0 + x1*)/2, x1* a constant and
@@ -159,6 +184,10 @@ Matrix<T> midpoint_solve(const nn::DynamicsModel<T>& model, const Matrix<T>& x0,
     return x0 + (f.array().colwise() * h.col(0).array()).matrix();
   };
   Matrix<T> x1 = step(model.field(x0));  // explicit Euler: the first guess
+  Matrix<T> accepted = x1;  // per row, the last iterate that did not raise its residual
+  Eigen::VectorXd accepted_norm = Eigen::VectorXd::Constant(x0.rows(), INFINITY);
+  Eigen::Matrix<T, Eigen::Dynamic, 1> damping =
+      Eigen::Matrix<T, Eigen::Dynamic, 1>::Ones(x0.rows());
   double previous = std::numeric_limits<double>::infinity();
   bool newton = false;
   Matrix<T> a;  // A of the chord iterations, refreshed when they slow down
@@ -169,8 +198,15 @@ Matrix<T> midpoint_solve(const nn::DynamicsModel<T>& model, const Matrix<T>& x0,
     const Matrix<T> residual = x1 - next;
     worst = worst_residual<T>(residual, x1);
     if (worst.first <= double(tolerance)) return x1;
-    if (std::isnan(worst.first) || it == solve.max_iterations) break;
+    if (it == solve.max_iterations) break;
     ++t_midpoint_iterations;
+    const bool backtracked =
+        backtrack_rows<T>(residual, tolerance, it, x1, accepted, accepted_norm, damping);
+    if (backtracked) {
+      newton = true;
+      a.resize(0, 0);
+      continue;
+    }
     // Fixed-point iteration while it contracts fast; then Newton's chord method (the Jacobian
     // kept while the residual falls at least fourfold per iteration: a Jacobian costs one
     // backward sweep per state column, a chord iteration one field call).
@@ -179,7 +215,7 @@ Matrix<T> midpoint_solve(const nn::DynamicsModel<T>& model, const Matrix<T>& x0,
     if (newton) {
       if (a.size() == 0 || ratio > 0.25)
         a = newton_matrix<T>(field_row_jacobian(model, m), h, x0.cols());
-      x1 -= solve_rows<T>(a, residual);
+      x1 -= (solve_rows<T>(a, residual).array().colwise() * damping.array()).matrix();
     } else {
       x1 = next;
     }
