@@ -15,45 +15,70 @@
 namespace hnn::ad {
 
 // ---- elementwise arithmetic (broadcasting) ---------------------------------------------------
-template <typename T> Var<T> add(const Var<T>& a, const Var<T>& b);  // d/da = 1, d/db = 1
-template <typename T> Var<T> sub(const Var<T>& a, const Var<T>& b);  // 1, -1
-template <typename T> Var<T> mul(const Var<T>& a, const Var<T>& b);  // b, a
-template <typename T> Var<T> div(const Var<T>& a, const Var<T>& b);  // 1/b, -a/b^2
-template <typename T> Var<T> neg(const Var<T>& a);                   // -1
-template <typename T> Var<T> scale(const Var<T>& a, std::type_identity_t<T> s);            // s * a: d = s
-template <typename T> Var<T> shift(const Var<T>& a, std::type_identity_t<T> s);            // a + s: d = 1
+template <typename T>
+Var<T> add(const Var<T>& a, const Var<T>& b);  // d/da = 1, d/db = 1
+template <typename T>
+Var<T> sub(const Var<T>& a, const Var<T>& b);  // 1, -1
+template <typename T>
+Var<T> mul(const Var<T>& a, const Var<T>& b);  // b, a
+template <typename T>
+Var<T> div(const Var<T>& a, const Var<T>& b);  // 1/b, -a/b^2
+template <typename T>
+Var<T> neg(const Var<T>& a);  // -1
+template <typename T>
+Var<T> scale(const Var<T>& a, std::type_identity_t<T> s);  // s * a: d = s
+template <typename T>
+Var<T> shift(const Var<T>& a, std::type_identity_t<T> s);  // a + s: d = 1
 
 // ---- elementwise functions -------------------------------------------------------------------
-template <typename T> Var<T> square(const Var<T>& x);         // 2x
-template <typename T> Var<T> pow(const Var<T>& x, std::type_identity_t<T> exponent);  // e x^(e-1)
-template <typename T> Var<T> sqrt(const Var<T>& x);           // 1 / (2 sqrt x)
-template <typename T> Var<T> exp(const Var<T>& x);            // exp x
-template <typename T> Var<T> log(const Var<T>& x);            // 1 / x
-template <typename T> Var<T> sin(const Var<T>& x);            // cos x
-template <typename T> Var<T> cos(const Var<T>& x);            // -sin x
-template <typename T> Var<T> tanh(const Var<T>& x);           // 1 - tanh^2 x (fused, below)
-template <typename T> Var<T> sigmoid(const Var<T>& x);        // s (1 - s)
-template <typename T> Var<T> relu(const Var<T>& x);           // step(x)
-template <typename T> Var<T> softplus(const Var<T>& x);       // sigmoid x
-template <typename T> Var<T> elu(const Var<T>& x, std::type_identity_t<T> alpha = T(1));  // 1 | alpha exp x
-template <typename T> Var<T> selu(const Var<T>& x);           // scale * elu(x, alpha)
-template <typename T> Var<T> swish(const Var<T>& x);          // x sigmoid x (composite)
+template <typename T>
+Var<T> square(const Var<T>& x);  // 2x
+template <typename T>
+Var<T> pow(const Var<T>& x, std::type_identity_t<T> exponent);  // e x^(e-1)
+template <typename T>
+Var<T> sqrt(const Var<T>& x);  // 1 / (2 sqrt x)
+template <typename T>
+Var<T> exp(const Var<T>& x);  // exp x
+template <typename T>
+Var<T> log(const Var<T>& x);  // 1 / x
+template <typename T>
+Var<T> sin(const Var<T>& x);  // cos x
+template <typename T>
+Var<T> cos(const Var<T>& x);  // -sin x
+template <typename T>
+Var<T> tanh(const Var<T>& x);  // 1 - tanh^2 x (fused, below)
+template <typename T>
+Var<T> sigmoid(const Var<T>& x);  // s (1 - s)
+template <typename T>
+Var<T> relu(const Var<T>& x);  // step(x)
+template <typename T>
+Var<T> softplus(const Var<T>& x);  // sigmoid x
+template <typename T>
+Var<T> elu(const Var<T>& x, std::type_identity_t<T> alpha = T(1));  // 1 | alpha exp x
+template <typename T>
+Var<T> selu(const Var<T>& x);  // scale * elu(x, alpha)
+template <typename T>
+Var<T> swish(const Var<T>& x);  // x sigmoid x (composite)
 
 /// Gradient of tanh given its output y: g * (1 - y^2). Itself differentiable in g and y
 /// (d/dg = 1 - y^2, d/dy = -2 y g), which is what makes HNN training fast and exact.
-template <typename T> Var<T> tanh_backward(const Var<T>& g, const Var<T>& y);
+template <typename T>
+Var<T> tanh_backward(const Var<T>& g, const Var<T>& y);
 
 /// The step function x > 0 as a constant mask (its derivative is zero almost everywhere).
-template <typename T> Var<T> step(const Var<T>& x);
+template <typename T>
+Var<T> step(const Var<T>& x);
 
 // ---- linear algebra --------------------------------------------------------------------------
 /// op(a) op(b), op = transpose when the flag is set; transposes are never materialised.
 template <typename T>
 Var<T> matmul(const Var<T>& a, const Var<T>& b, bool transpose_a = false, bool transpose_b = false);
-template <typename T> Var<T> transpose(const Var<T>& a);
+template <typename T>
+Var<T> transpose(const Var<T>& a);
 /// Fused layer x W + b (b a 1xC row, optional: pass an empty Var). d/dx = g W^T,
 /// d/dW = x^T g, d/db = sum_rows g.
-template <typename T> Var<T> linear(const Var<T>& x, const Var<T>& w, const Var<T>& b = {});
+template <typename T>
+Var<T> linear(const Var<T>& x, const Var<T>& w, const Var<T>& b = {});
 
 // ---- batched small linear algebra: one block per row of the batch -------------------------
 // Row r of `a` holds a small matrix A_r flattened row-major (n x n: R x n^2), row r of a vector
@@ -88,34 +113,81 @@ template <typename T>
 Var<T> batched_outer(const Var<T>& u, const Var<T>& v);
 
 // ---- reductions and shapes -------------------------------------------------------------------
-template <typename T> Var<T> sum(const Var<T>& a);       // -> 1x1
-template <typename T> Var<T> mean(const Var<T>& a);      // -> 1x1
-template <typename T> Var<T> sum_rows(const Var<T>& a);  // sum over the batch -> 1xC
-template <typename T> Var<T> sum_cols(const Var<T>& a);  // sum over features -> Rx1
-template <typename T> Var<T> mean_rows(const Var<T>& a);
-template <typename T> Var<T> mean_cols(const Var<T>& a);
+template <typename T>
+Var<T> sum(const Var<T>& a);  // -> 1x1
+template <typename T>
+Var<T> mean(const Var<T>& a);  // -> 1x1
+template <typename T>
+Var<T> sum_rows(const Var<T>& a);  // sum over the batch -> 1xC
+template <typename T>
+Var<T> sum_cols(const Var<T>& a);  // sum over features -> Rx1
+template <typename T>
+Var<T> mean_rows(const Var<T>& a);
+template <typename T>
+Var<T> mean_cols(const Var<T>& a);
 /// Repeats a row, column or scalar to rows x cols (the adjoint of sum_to).
-template <typename T> Var<T> broadcast_to(const Var<T>& a, Eigen::Index rows, Eigen::Index cols);
+template <typename T>
+Var<T> broadcast_to(const Var<T>& a, Eigen::Index rows, Eigen::Index cols);
 /// Sums a to rows x cols, where each target dimension is a's or 1 (the adjoint of broadcast_to).
-template <typename T> Var<T> sum_to(const Var<T>& a, Eigen::Index rows, Eigen::Index cols);
+template <typename T>
+Var<T> sum_to(const Var<T>& a, Eigen::Index rows, Eigen::Index cols);
 /// Columns [start, start + count).
-template <typename T> Var<T> slice_cols(const Var<T>& a, Eigen::Index start, Eigen::Index count);
+template <typename T>
+Var<T> slice_cols(const Var<T>& a, Eigen::Index start, Eigen::Index count);
 /// a placed at columns [start, start + a.cols()) of a zero matrix with `cols` columns.
-template <typename T> Var<T> pad_cols(const Var<T>& a, Eigen::Index start, Eigen::Index cols);
-template <typename T> Var<T> concat_cols(const std::vector<Var<T>>& parts);
+template <typename T>
+Var<T> pad_cols(const Var<T>& a, Eigen::Index start, Eigen::Index cols);
+template <typename T>
+Var<T> concat_cols(const std::vector<Var<T>>& parts);
 
 // ---- operators -------------------------------------------------------------------------------
-template <typename T> Var<T> operator+(const Var<T>& a, const Var<T>& b) { return add(a, b); }
-template <typename T> Var<T> operator-(const Var<T>& a, const Var<T>& b) { return sub(a, b); }
-template <typename T> Var<T> operator*(const Var<T>& a, const Var<T>& b) { return mul(a, b); }
-template <typename T> Var<T> operator/(const Var<T>& a, const Var<T>& b) { return div(a, b); }
-template <typename T> Var<T> operator-(const Var<T>& a) { return neg(a); }
-template <typename T> Var<T> operator*(const Var<T>& a, std::type_identity_t<T> s) { return scale(a, s); }
-template <typename T> Var<T> operator*(std::type_identity_t<T> s, const Var<T>& a) { return scale(a, s); }
-template <typename T> Var<T> operator/(const Var<T>& a, std::type_identity_t<T> s) { return scale(a, T(1) / s); }
-template <typename T> Var<T> operator+(const Var<T>& a, std::type_identity_t<T> s) { return shift(a, s); }
-template <typename T> Var<T> operator+(std::type_identity_t<T> s, const Var<T>& a) { return shift(a, s); }
-template <typename T> Var<T> operator-(const Var<T>& a, std::type_identity_t<T> s) { return shift(a, -s); }
-template <typename T> Var<T> operator-(std::type_identity_t<T> s, const Var<T>& a) { return shift(neg(a), s); }
+template <typename T>
+Var<T> operator+(const Var<T>& a, const Var<T>& b) {
+  return add(a, b);
+}
+template <typename T>
+Var<T> operator-(const Var<T>& a, const Var<T>& b) {
+  return sub(a, b);
+}
+template <typename T>
+Var<T> operator*(const Var<T>& a, const Var<T>& b) {
+  return mul(a, b);
+}
+template <typename T>
+Var<T> operator/(const Var<T>& a, const Var<T>& b) {
+  return div(a, b);
+}
+template <typename T>
+Var<T> operator-(const Var<T>& a) {
+  return neg(a);
+}
+template <typename T>
+Var<T> operator*(const Var<T>& a, std::type_identity_t<T> s) {
+  return scale(a, s);
+}
+template <typename T>
+Var<T> operator*(std::type_identity_t<T> s, const Var<T>& a) {
+  return scale(a, s);
+}
+template <typename T>
+Var<T> operator/(const Var<T>& a, std::type_identity_t<T> s) {
+  return scale(a, T(1) / s);
+}
+template <typename T>
+Var<T> operator+(const Var<T>& a, std::type_identity_t<T> s) {
+  return shift(a, s);
+}
+template <typename T>
+Var<T> operator+(std::type_identity_t<T> s, const Var<T>& a) {
+  return shift(a, s);
+}
+template <typename T>
+Var<T> operator-(const Var<T>& a, std::type_identity_t<T> s) {
+  return shift(a, -s);
+}
+template <typename T>
+Var<T> operator-(std::type_identity_t<T> s, const Var<T>& a) {
+  return shift(neg(a), s);
+}
 
 }  // namespace hnn::ad

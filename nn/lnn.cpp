@@ -27,10 +27,12 @@ const DynamicsConfig& require_lnn(const DynamicsConfig& config) {
 // block flattened row-major: the v-v or v-q part of the Hessian of L.
 template <typename T>
 ad::Var<T> hessian_block(const ad::Var<T>& jacobian, Index n, Index offset) {
-  std::vector<ad::Var<T>> rows;
-  rows.reserve(std::size_t(n));
+  thread_local std::vector<ad::Var<T>> rows;  // reused: no allocation per step
+  rows.clear();
   for (Index j = 0; j < n; ++j) rows.push_back(ad::slice_cols(jacobian, j * 2 * n + offset, n));
-  return ad::concat_cols<T>(rows);
+  const ad::Var<T> block = ad::concat_cols<T>(rows);
+  rows.clear();
+  return block;
 }
 
 }  // namespace
@@ -55,11 +57,10 @@ Matrix<T> Lnn<T>::energy(const Matrix<T>& x) const {
   ad::TapeScope scope;
   ad::GradModeGuard record(true);
   const Index n = x.cols() / 2;
-  const ad::Var<T> in = ad::Var<T>::leaf(x);
-  const ad::Var<T> dl = this->mlp_.input_gradient(this->mlp_input(in), 0);
-  const Matrix<T> v = x.rightCols(n);
-  return (v.cwiseProduct(dl.value().rightCols(n)).rowwise().sum() -
-          this->mlp_.forward(this->mlp_input(in)).value())
+  const ad::Var<T> in = this->mlp_input(ad::Var<T>::leaf(x));
+  const Matrix<T> dl = this->mlp_.input_gradient(in, 0).value();
+  return (x.rightCols(n).cwiseProduct(dl.rightCols(n)).rowwise().sum() -
+          this->mlp_.forward(in).value())
       .eval();
 }
 

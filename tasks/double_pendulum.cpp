@@ -5,13 +5,14 @@
 // velocities U[0, 0.1)), 29.4 = 3 g being the scale of the potential. An HNN needs canonical
 // momenta, which these coordinates are not: the task trains an LNN or a baseline.
 
+#include "physics/double_pendulum.h"
+
 #include <algorithm>
 #include <cmath>
 
-#include "physics/double_pendulum.h"
+#include "tasks/error.h"
 #include "tasks/experiments.h"
 #include "tasks/field_task.h"
-#include "tasks/error.h"
 #include "tasks/report/json_values.h"
 
 namespace hnn::tasks {
@@ -61,7 +62,8 @@ class DoublePendulumTask : public FieldTask {
   // Settings "rollouts" (1..1000) and "t_end" (> 0): fewer or shorter for quick runs.
   RolloutConfig rollout_config(const nlohmann::json& s) const override {
     RolloutConfig c = rollout_config();
-    c.trajectories = json_integer<int>(s.value("rollouts", nlohmann::json(c.trajectories)), "rollouts");
+    c.trajectories =
+        json_integer<int>(s.value("rollouts", nlohmann::json(c.trajectories)), "rollouts");
     c.t_end = s.value("t_end", c.t_end);
     c.points = std::max(2, int(std::lround(c.t_end * 10)) + 1);
     return c;
@@ -97,8 +99,6 @@ class DoublePendulumTask : public FieldTask {
 
 }  // namespace
 
-std::unique_ptr<Task> make_double_pendulum_task() {
-  return std::make_unique<DoublePendulumTask>();
-}
+std::unique_ptr<Task> make_double_pendulum_task() { return std::make_unique<DoublePendulumTask>(); }
 
 }  // namespace hnn::tasks

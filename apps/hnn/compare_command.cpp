@@ -329,18 +329,7 @@ void add_compare_command(CLI::App& app, int argc, char** argv) {
                 fmt::format("A smoke run: {} steps a run unless --steps", kQuickSteps));
   cmd->add_option("--out", o->out, "Folder: runs/, results.csv, compare.md/.json, the chart")
       ->required();
-  cmd->add_option("--scheduler", o->launch.scheduler,
-                  "A running Dask scheduler, tcp://HOST:PORT, whose workers share --out "
-                  "(default: a local cluster)");
-  cmd->add_option("--workers", o->launch.workers,
-                  "Local cluster's workers (default: the cores / --threads-per-run)")
-      ->check(integer_in(1, 1024));
-  cmd->add_option("--threads-per-run", o->launch.threads_per_run,
-                  "hnn train --threads of every run")
-      ->check(integer_in(1, 256))
-      ->capture_default_str();
-  cmd->add_flag("--retry-failed", o->launch.retry_failed,
-                "Run again the runs that failed for their own reasons");
+  sweep::add_launch_options(*cmd, o->launch);
   cmd->add_flag("--list", o->list,
                 "Print each task, model and loss (its runs, or why it is skipped) and each run's "
                 "hnn train command; run nothing");

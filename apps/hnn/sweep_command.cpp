@@ -45,20 +45,9 @@ void add_sweep_command(CLI::App& app) {
       ->check(CLI::ExistingFile);
   cmd->add_option("--out", o->out, "Sweep folder: runs/, plan.json, results.csv and .json")
       ->required();
-  cmd->add_option("--scheduler", o->launch.scheduler,
-                  "A running Dask scheduler, tcp://HOST:PORT, whose workers share --out "
-                  "(default: a local cluster)");
-  cmd->add_option("--workers", o->launch.workers,
-                  "Local cluster's workers (default: the cores / --threads-per-run)")
-      ->check(integer_in(1, 1024));
-  cmd->add_option("--threads-per-run", o->launch.threads_per_run,
-                  "hnn train --threads of every run")
-      ->check(integer_in(1, 256))
-      ->capture_default_str();
+  sweep::add_launch_options(*cmd, o->launch);
   cmd->add_flag("--collect", o->collect,
                 "Only gather the finished runs into results.csv/.json (after --emit slurm)");
-  cmd->add_flag("--retry-failed", o->launch.retry_failed,
-                "Run again the runs that failed for their own reasons (default: report them)");
   cmd->add_option("--emit", o->emit, "Write DIR/sweep.slurm, a Slurm job array of the runs")
       ->check(CLI::IsMember({"slurm"}));
   cmd->add_flag("--list", o->list, "Print each run's hnn train command; run nothing");

@@ -16,9 +16,24 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "apps/hnn/validators.h"
 #include "tasks/report/atomic_file.h"
 
 namespace hnn::app::sweep {
+
+void add_launch_options(CLI::App& cmd, LaunchOptions& o) {
+  cmd.add_option("--scheduler", o.scheduler,
+                 "A running Dask scheduler, tcp://HOST:PORT, whose workers share --out "
+                 "(default: a local cluster)");
+  cmd.add_option("--workers", o.workers,
+                 "Local cluster's workers (default: the cores / --threads-per-run)")
+      ->check(integer_in(1, 1024));
+  cmd.add_option("--threads-per-run", o.threads_per_run, "hnn train --threads of every run")
+      ->check(integer_in(1, 256))
+      ->capture_default_str();
+  cmd.add_flag("--retry-failed", o.retry_failed,
+               "Run again the runs that failed for their own reasons (default: report them)");
+}
 
 namespace {
 

@@ -9,6 +9,10 @@
 
 #include "apps/hnn/sweep_spec.h"
 
+namespace CLI {
+class App;
+}  // namespace CLI
+
 namespace hnn::app::sweep {
 
 /// How the plan runs; the options of `hnn sweep` that are not the spec.
@@ -18,6 +22,9 @@ struct LaunchOptions {
   int threads_per_run = 1;
   bool retry_failed = false;
 };
+
+/// Adds --scheduler, --workers, --threads-per-run and --retry-failed to `cmd`, into `o`.
+void add_launch_options(CLI::App& cmd, LaunchOptions& o);
 
 /// `text` as one shell word.
 std::string shell_quote(const std::string& text);

@@ -138,11 +138,12 @@ nn::MeanStderr energy_error_at_end(const Rollouts& r, double scale) {
   const Eigen::Index end = r.true_energy.cols() - 1;
   for (std::size_t i = 0; i < r.failed.size(); ++i) {
     const Eigen::Index row = Eigen::Index(i);
-    if (!r.failed[i]) errors.push_back(std::abs(r.pred_energy(row, end) - r.true_energy(row, end)) / scale);
+    if (!r.failed[i])
+      errors.push_back(std::abs(r.pred_energy(row, end) - r.true_energy(row, end)) / scale);
   }
   if (errors.empty()) return {.mean = NAN, .std_error = NAN, .count = 0};
-  return nn::mean_and_stderr<double>(
-      Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(errors.data(), Eigen::Index(errors.size()))));
+  return nn::mean_and_stderr<double>(Eigen::VectorXd(
+      Eigen::Map<const Eigen::VectorXd>(errors.data(), Eigen::Index(errors.size()))));
 }
 
 double state_mse(const Rollouts& r) {

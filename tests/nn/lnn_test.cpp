@@ -5,8 +5,8 @@
 
 #include <gtest/gtest.h>
 
-#include <cmath>
 #include <Eigen/LU>
+#include <cmath>
 #include <numbers>
 
 #include "nn_test_util.h"
@@ -28,17 +28,20 @@ MatrixD random_states(Eigen::Index rows, Eigen::Index dim, std::uint64_t seed, d
 // An LNN whose L has a clearly positive-definite d²L/dv² near the states tested: a small random
 // MLP plus nothing else would be indefinite, so tests pick seeds and states where the solve is
 // well posed and check the conditioning they rely on.
-nn::Lnn<double> small_lnn(Eigen::Index dim, std::uint64_t seed, nn::Activation act = nn::Activation::kTanh) {
+nn::Lnn<double> small_lnn(Eigen::Index dim, std::uint64_t seed,
+                          nn::Activation act = nn::Activation::kTanh) {
   std::mt19937_64 rng(seed);
-  return nn::Lnn<double>(small_config(ModelKind::kLnn, dim, {12, 12}, nn::FieldType::kSolenoidal, act),
-                         rng);
+  return nn::Lnn<double>(
+      small_config(ModelKind::kLnn, dim, {12, 12}, nn::FieldType::kSolenoidal, act), rng);
 }
 
 // The acceleration of row r by hand: ad::hessian of L at that row alone, solved by Eigen.
 Eigen::VectorXd acceleration_by_hand(const nn::Lnn<double>& lnn, const MatrixD& x, Eigen::Index r) {
   const Eigen::Index n = x.cols() / 2;
   const MatrixD row = x.row(r);
-  const ad::VarFunction<double> l = [&](const Var<double>& v) { return ad::sum(lnn.lagrangian(v)); };
+  const ad::VarFunction<double> l = [&](const Var<double>& v) {
+    return ad::sum(lnn.lagrangian(v));
+  };
   const MatrixD h = ad::hessian<double>(l, row);
   const MatrixD g = ad::jacobian<double>(l, row);  // 1 x 2n
   const MatrixD hvv = h.bottomRightCorner(n, n), hvq = h.bottomLeftCorner(n, n);

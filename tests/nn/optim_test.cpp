@@ -13,7 +13,7 @@ using ad::Var;
 using MatrixD = nn::Matrix<double>;
 
 // ---- counting heap allocations --------------------------------------------------------------
-// malloc is interposed by allocation_test.cpp (not under the sanitizers: see malloc_counter.h).
+// malloc is interposed by tests/malloc_counter.cpp (not under the sanitizers).
 
 namespace {
 

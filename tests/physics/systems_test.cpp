@@ -228,11 +228,11 @@ TEST(DoublePendulumVelocities, MovesAsTheCanonicalSystemAndConservesEnergy) {
                   .maxCoeff(),
               1e-9);
   }
-  EXPECT_LT((lagrangian.hamiltonian_batch(in_velocities.states.back()) -
-             lagrangian.hamiltonian_batch(v0))
-                .cwiseAbs()
-                .maxCoeff(),
-            1e-9);
+  EXPECT_LT(
+      (lagrangian.hamiltonian_batch(in_velocities.states.back()) - lagrangian.hamiltonian_batch(v0))
+          .cwiseAbs()
+          .maxCoeff(),
+      1e-9);
 }
 
 }  // namespace

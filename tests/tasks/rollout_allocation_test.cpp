@@ -1,62 +1,18 @@
 // A rollout-loss training step (sample, loss through the integrator, gradients, Adam) allocates
 // nothing on the heap once warmed up, for the explicit integrators; the implicit midpoint's
-// off-tape solve still does (counted, reported). Counted by interposing malloc in this test
-// program, as tests/nn/allocation_test.cpp does for the HNN step.
+// off-tape solve still does (counted, reported). Counted by tests/malloc_counter.cpp, as
+// tests/nn/allocation_test.cpp counts the HNN step.
 
 #include <gtest/gtest.h>
 
-#include <atomic>
 #include <cstdlib>
 #include <random>
 
 #include "autodiff/autodiff.h"
+#include "malloc_counter.h"
 #include "nn/hnn.h"
-#include "nn/malloc_counter.h"
 #include "nn/optim.h"
 #include "tasks/train/rollout_objective.h"
-
-namespace {
-std::atomic<long> g_allocations{0};
-}  // namespace
-
-long hnn::testing::allocation_count() { return g_allocations.load(); }
-
-#if HNN_COUNTS_ALLOCATIONS
-#define HNN_COUNT_ALLOCATIONS 1
-
-extern "C" {
-void* __libc_malloc(std::size_t);
-void* __libc_calloc(std::size_t, std::size_t);
-void* __libc_realloc(void*, std::size_t);
-void* __libc_memalign(std::size_t, std::size_t);
-
-void* malloc(std::size_t n) {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  return __libc_malloc(n);
-}
-void* calloc(std::size_t n, std::size_t size) {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  return __libc_calloc(n, size);
-}
-void* realloc(void* p, std::size_t n) {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  return __libc_realloc(p, n);
-}
-void* aligned_alloc(std::size_t alignment, std::size_t n) {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  return __libc_memalign(alignment, n);
-}
-void* memalign(std::size_t alignment, std::size_t n) {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  return __libc_memalign(alignment, n);
-}
-int posix_memalign(void** out, std::size_t alignment, std::size_t n) {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  *out = __libc_memalign(alignment, n);
-  return *out ? 0 : 12;  // ENOMEM
-}
-}
-#endif
 
 namespace hnn::tasks {
 namespace {
@@ -75,7 +31,7 @@ long allocations(RolloutIntegrator method, int warmup, int steps) {
   std::vector<ad::Var<double>> grads;
   long counted = 0;
   for (int step = 0; step < warmup + steps; ++step) {
-    const long before = g_allocations.load();
+    const long before = hnn::testing::allocation_count();
     {
       ad::TapeScope scope;
       objective.sampler().next();
@@ -83,13 +39,13 @@ long allocations(RolloutIntegrator method, int warmup, int steps) {
       ad::grad_into(loss, adam.parameters(), grads);
       adam.step(grads);
     }
-    if (step >= warmup) counted += g_allocations.load() - before;
+    if (step >= warmup) counted += hnn::testing::allocation_count() - before;
   }
   return counted;
 }
 
 TEST(RolloutAllocations, ExplicitIntegratorStepsAllocateNothingAfterWarmUp) {
-#ifndef HNN_COUNT_ALLOCATIONS
+#if !HNN_COUNTS_ALLOCATIONS
   GTEST_SKIP() << "malloc belongs to the sanitizer in this build";
 #endif
   for (RolloutIntegrator method :

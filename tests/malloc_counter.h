@@ -1,6 +1,8 @@
 #pragma once
-// Heap allocations counted by interposing glibc's malloc family in the nn test program
-// (defined in allocation_test.cpp). Not under the sanitizers, which own malloc.
+// Heap allocations counted by interposing glibc's malloc family in the test programs that link
+// tests/malloc_counter.cpp. Not under the sanitizers, which own malloc.
+
+#include <cstddef>  // brings in <features.h>, which defines __GLIBC__
 
 #if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__) || !defined(__GLIBC__)
 #define HNN_COUNTS_ALLOCATIONS 0
