@@ -173,6 +173,15 @@ ad::Var<T> DynamicsModel<T>::mlp_input(const ad::Var<T>& x) const {
   return in;
 }
 
+template <typename T>
+ad::Var<T> DynamicsModel<T>::input_gradient(const ad::Var<T>& x, Index column) const {
+  const ad::Var<T> g = mlp_.input_gradient(mlp_input(x), column);
+  if (config_.input_scale.empty()) return g;
+  const Eigen::Map<const Eigen::RowVectorXd> scale(config_.input_scale.data(),
+                                                   Eigen::Index(config_.input_scale.size()));
+  return g * ad::Var<T>::constant(Matrix<T>(scale.cwiseInverse().template cast<T>()));
+}
+
 template class DynamicsModel<float>;
 template class DynamicsModel<double>;
 

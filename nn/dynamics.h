@@ -96,6 +96,9 @@ class DynamicsModel : public Module<T> {
   /// scales (x itself when there are neither). The wrap is a constant shift and the scale a
   /// constant factor, so derivatives with respect to x pass through exactly.
   ad::Var<T> mlp_input(const ad::Var<T>& x) const;
+  /// d mlp(mlp_input(x))[:, column] / dx: Mlp::input_gradient at the MLP's input, carried back
+  /// through the input scales (the chain rule's constant factor 1 / scale).
+  ad::Var<T> input_gradient(const ad::Var<T>& x, Index column) const;
 
   DynamicsConfig config_;
   Mlp<T> mlp_;

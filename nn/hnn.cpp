@@ -80,13 +80,12 @@ template <typename T>
 typename Hnn<T>::Parts Hnn<T>::time_derivative_parts(const ad::Var<T>& x) const {
   this->check_input("time_derivative", x.rows(), x.cols());
   const FieldType field = this->config_.field;
-  const ad::Var<T> in = this->mlp_input(x);
   Parts parts;
   if (field != FieldType::kConservative) {
-    parts.solenoidal = symplectic_gradient(this->mlp_.input_gradient(in, 0));
+    parts.solenoidal = symplectic_gradient(this->input_gradient(x, 0));
   }
   if (field != FieldType::kSolenoidal) {
-    parts.conservative = this->mlp_.input_gradient(in, this->mlp_.output_dim() - 1);
+    parts.conservative = this->input_gradient(x, this->mlp_.output_dim() - 1);
   }
   return parts;
 }

@@ -57,10 +57,10 @@ Matrix<T> Lnn<T>::energy(const Matrix<T>& x) const {
   ad::TapeScope scope;
   ad::GradModeGuard record(true);
   const Index n = x.cols() / 2;
-  const ad::Var<T> in = this->mlp_input(ad::Var<T>::leaf(x));
-  const Matrix<T> dl = this->mlp_.input_gradient(in, 0).value();
+  const ad::Var<T> in = ad::Var<T>::leaf(x);
+  const Matrix<T> dl = this->input_gradient(in, 0).value();
   return (x.rightCols(n).cwiseProduct(dl.rightCols(n)).rowwise().sum() -
-          this->mlp_.forward(in).value())
+          this->mlp_.forward(this->mlp_input(in)).value())
       .eval();
 }
 
@@ -76,7 +76,7 @@ ad::Var<T> Lnn<T>::time_derivative(const ad::Var<T>& x) const {
   // Differentiating with respect to x needs x to require gradients: a constant batch becomes a
   // leaf (its copy is the only cost).
   const ad::Var<T> in = x.requires_grad() ? x : ad::Var<T>::leaf(x.value());
-  const ad::Var<T> dl = this->mlp_.input_gradient(this->mlp_input(in), 0);
+  const ad::Var<T> dl = this->input_gradient(in, 0);
   const ad::Var<T> dl_dv = ad::slice_cols(dl, n, n);
   const ad::Var<T> jacobian = ad::row_jacobian(dl_dv, in, {.create_graph = record});
   ad::GradModeGuard outer(record);

@@ -73,6 +73,32 @@ TEST(Lnn, AccelerationIsTheEulerLagrangeSolveOfEachRow) {
   }
 }
 
+// The field of every model family is its formula in x itself when the MLP sees x / scale: the
+// acceleration against the by-hand solve (ad::hessian of lagrangian(x)), and an HNN's field
+// against the symplectic gradient of its energy(x).
+TEST(Lnn, InputScalesLeaveTheEulerLagrangeEquationsOfLIntact) {
+  std::mt19937_64 rng(71);
+  nn::DynamicsConfig config = small_config(ModelKind::kLnn, 4, {12, 12});
+  config.input_scale = {1.0, 2.0, 10.0, 5.0};
+  const nn::Lnn<double> lnn(config, rng);
+  const MatrixD x = random_states(4, 4, 72, 3.0);
+  const MatrixD f = lnn.field(x);
+  for (Eigen::Index r = 0; r < x.rows(); ++r) {
+    const Eigen::VectorXd a = acceleration_by_hand(lnn, x, r);
+    EXPECT_LT((f.row(r).rightCols(2).transpose() - a).cwiseAbs().maxCoeff(),
+              1e-9 * (1 + a.cwiseAbs().maxCoeff()))
+        << "row " << r;
+  }
+  config.model = ModelKind::kHnn;
+  const nn::Hnn<double> hnn(config, rng);
+  ad::TapeScope scope;
+  const Var<double> xv = Var<double>::leaf(x);
+  const MatrixD dh = ad::grad<double>({ad::sum(hnn.energy(xv))}, {xv})[0].value();
+  const MatrixD g = hnn.field(x);
+  EXPECT_LT((g.leftCols(2) - dh.rightCols(2)).cwiseAbs().maxCoeff(), 1e-12);
+  EXPECT_LT((g.rightCols(2) + dh.leftCols(2)).cwiseAbs().maxCoeff(), 1e-12);
+}
+
 TEST(Lnn, TrainingLossMatchesFiniteDifferencesUpToSecondOrder) {
   const nn::Lnn<double> lnn = [] {
     std::mt19937_64 rng(21);
