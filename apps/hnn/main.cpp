@@ -111,7 +111,8 @@ void add_train_command(CLI::App& app) {
   auto checkpoint_every = std::make_shared<long>(0);
   cmd->add_option("task", options->task, "Task: " + task_list() + " (required unless --resume)");
   cmd->add_option("--model", *model,
-                  "hnn, baseline or dhnn (the dissipative HNN: H and a dissipation potential D)")
+                  "hnn, baseline, dhnn (the dissipative HNN: H and a dissipation potential D) or "
+                  "lnn (the Lagrangian NN: L(q, dq/dt))")
       ->check(CLI::IsMember(tasks::model_names()))
       ->capture_default_str();
   cmd->add_option("--steps", *steps, "Training steps (default: the paper's)")
