@@ -102,6 +102,11 @@ TEST(Allocations, DissipativeAndLagrangianStepsAllocateNothingAfterWarmUp) {
       EXPECT_EQ(allocations_per_steps<float>(small_lnn(act), threads, 64, 3, 10), 0)
           << "LNN, " << nn::to_string(act) << ", float, " << threads << " thread(s)";
     }
+    // Big enough that the elementwise ops split their rows across the threads too.
+    nn::DynamicsConfig wide = small_lnn(nn::Activation::kSoftplus);
+    wide.hidden = {128, 128};
+    EXPECT_EQ(allocations_per_steps<float>(wide, threads, 512, 2, 3), 0)
+        << "LNN 128-128, 512 rows, float, " << threads << " thread(s)";
   }
 }
 
