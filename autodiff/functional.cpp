@@ -53,19 +53,33 @@ Var<T> row_jacobian(const Var<T>& y, const Var<T>& x, const GradOptions& options
                y.shape(), x.shape());
   HNN_AD_CHECK(y.cols() > 0, "row_jacobian: y {} has no columns", y.shape());
   if (!y.requires_grad() && options.allow_unused) return zeros<T>(x.rows(), y.cols() * x.cols());
-  std::vector<Var<T>> blocks;  // block j: d y[:, j] / d x, R x n
-  blocks.reserve(std::size_t(y.cols()));
-  for (Eigen::Index j = 0; j < y.cols(); ++j)
-    blocks.push_back(grad<T>({y}, {x}, options, {column_seed<T>(y.rows(), y.cols(), j)})[0]);
-  return concat_cols(blocks);
+  // Reused per thread, so a warmed-up training step allocates nothing; emptied before returning
+  // so that no handle outlives the call. (No backward formula calls row_jacobian: no nesting.)
+  thread_local std::vector<Var<T>> blocks, inputs, block;  // block j: d y[:, j] / d x, R x n
+  blocks.clear();
+  inputs.assign(1, x);
+  for (Eigen::Index j = 0; j < y.cols(); ++j) {
+    grad_into<T>(y, inputs, block, options, column_seed<T>(y.rows(), y.cols(), j));
+    blocks.push_back(block[0]);
+  }
+  const Var<T> jacobian = concat_cols(blocks);
+  blocks.clear();
+  inputs.clear();
+  block.clear();
+  return jacobian;
 }
 
 template <typename T>
 Var<T> row_hessian(const Var<T>& l, const Var<T>& x, const GradOptions& options) {
   HNN_AD_CHECK(l.cols() == 1 && l.rows() == x.rows(),
                "row_hessian: l must be one scalar per row of x {}, got {}", x.shape(), l.shape());
-  const Var<T> gradient =
-      grad<T>({l}, {x}, GradOptions{.create_graph = true, .allow_unused = options.allow_unused})[0];
+  thread_local std::vector<Var<T>> inputs, result;  // reused: no allocation per step
+  inputs.assign(1, x);
+  grad_into<T>(l, inputs, result,
+               GradOptions{.create_graph = true, .allow_unused = options.allow_unused});
+  const Var<T> gradient = result[0];
+  inputs.clear();  // no handle outlives the call
+  result.clear();
   // A gradient that is constant in x (l linear in x) has a zero Hessian, not an error.
   return row_jacobian(gradient, x,
                       GradOptions{.create_graph = options.create_graph, .allow_unused = true});

@@ -239,9 +239,11 @@ std::vector<Var<T>> grad(const std::vector<Var<T>>& outputs, const std::vector<V
 }
 
 template <typename T>
-void grad_into(const Var<T>& output, const std::vector<Var<T>>& inputs,
-               std::vector<Var<T>>& result, const GradOptions& options) {
-  grad_impl<T>(std::span<const Var<T>>(&output, 1), inputs, options, {}, result);
+void grad_into(const Var<T>& output, const std::vector<Var<T>>& inputs, std::vector<Var<T>>& result,
+               const GradOptions& options, const Var<T>& grad_output) {
+  const std::span<const Var<T>> seed =
+      grad_output.defined() ? std::span<const Var<T>>(&grad_output, 1) : std::span<const Var<T>>();
+  grad_impl<T>(std::span<const Var<T>>(&output, 1), inputs, options, seed, result);
 }
 
 template <typename T>
@@ -254,10 +256,10 @@ void backward(const Var<T>& output, const Var<T>& grad_output) {
   BorrowedBuffers<T> buffers;
   (*buffers).targets.clear();
   Sweep<T> sweep(*buffers, /*all_leaves=*/true);
-  sweep.run(std::span<const Var<T>>(&output, 1),
-            grad_output.defined() ? std::span<const Var<T>>(&grad_output, 1)
-                                  : std::span<const Var<T>>(),
-            /*create_graph=*/false);
+  sweep.run(
+      std::span<const Var<T>>(&output, 1),
+      grad_output.defined() ? std::span<const Var<T>>(&grad_output, 1) : std::span<const Var<T>>(),
+      /*create_graph=*/false);
   for (Node<T>* leaf : sweep.leaves()) {
     const Var<T> g = sweep.result(*leaf);
     if (!g.defined()) continue;
@@ -273,10 +275,10 @@ template std::vector<Var<float>> grad(const std::vector<Var<float>>&,
 template std::vector<Var<double>> grad(const std::vector<Var<double>>&,
                                        const std::vector<Var<double>>&, const GradOptions&,
                                        const std::vector<Var<double>>&);
-template void grad_into(const Var<float>&, const std::vector<Var<float>>&,
-                        std::vector<Var<float>>&, const GradOptions&);
+template void grad_into(const Var<float>&, const std::vector<Var<float>>&, std::vector<Var<float>>&,
+                        const GradOptions&, const Var<float>&);
 template void grad_into(const Var<double>&, const std::vector<Var<double>>&,
-                        std::vector<Var<double>>&, const GradOptions&);
+                        std::vector<Var<double>>&, const GradOptions&, const Var<double>&);
 template void backward(const Var<float>&, const Var<float>&);
 template void backward(const Var<double>&, const Var<double>&);
 

@@ -22,10 +22,11 @@ std::vector<Var<T>> grad(const std::vector<Var<T>>& outputs, const std::vector<V
                          const std::vector<Var<T>>& grad_outputs = {});
 
 /// grad() of one output into `result` (resized; its storage reused): the allocation-free form
-/// of a training loop's `grad({loss}, parameters)`.
+/// of a training loop's `grad({loss}, parameters)`, or, with grad_output, of
+/// `grad({y}, inputs, options, {grad_output})`.
 template <typename T>
-void grad_into(const Var<T>& output, const std::vector<Var<T>>& inputs,
-               std::vector<Var<T>>& result, const GradOptions& options = {});
+void grad_into(const Var<T>& output, const std::vector<Var<T>>& inputs, std::vector<Var<T>>& result,
+               const GradOptions& options = {}, const Var<T>& grad_output = {});
 
 /// Accumulates d output / d leaf into every leaf's grad() that requires gradients (the output
 /// must be 1x1 unless grad_output is given).

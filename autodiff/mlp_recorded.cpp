@@ -3,6 +3,8 @@
 // (create_graph), so that derivatives of any order work. The recomputed h_k equal the fused
 // forward's bit for bit (same GEMM on the same row blocks, the one tanh kernel).
 
+#include <cassert>
+
 #include "autodiff/mlp_layers.h"
 #include "autodiff/ops.h"
 
@@ -10,15 +12,46 @@ namespace hnn::ad::detail {
 
 namespace {
 
-// h_0 = x, h_k = tanh(h_{k-1} W_k + b_k) for the hidden layers k = 1..L-1, as ops.
+// The per-layer handles of a recorded backward, kept per thread so that a warmed-up step of
+// third order (an LNN's training step) allocates nothing. A Lease empties them on exit, so no
+// handle (the weights are leaves) outlives the call. The recorded backwards record plain ops
+// only, never a sweep, so they do not nest.
 template <typename T>
-std::vector<Var<T>> hidden_layers(const MlpLayers<T>& l) {
-  std::vector<Var<T>> h{l.x_var()};
+struct Scratch {
+  std::vector<Var<T>> h, a, d, hbar;
+  bool busy = false;
+
+  class Lease {
+   public:
+    Lease() : s_(instance()) {
+      assert(!s_.busy && "recorded MLP backwards do not nest");
+      s_.busy = true;
+    }
+    ~Lease() {
+      for (std::vector<Var<T>>* v : {&s_.h, &s_.a, &s_.d, &s_.hbar}) v->clear();
+      s_.busy = false;
+    }
+    Lease(const Lease&) = delete;
+    Lease& operator=(const Lease&) = delete;
+    Scratch* operator->() { return &s_; }
+
+   private:
+    static Scratch& instance() {
+      thread_local Scratch scratch;
+      return scratch;
+    }
+    Scratch& s_;
+  };
+};
+
+// h_0 = x, h_k = tanh(h_{k-1} W_k + b_k) for the hidden layers k = 1..L-1, as ops, into h.
+template <typename T>
+void hidden_layers(const MlpLayers<T>& l, std::vector<Var<T>>& h) {
+  h.assign(1, l.x_var());
   for (int k = 1; k < l.count(); ++k) {
     const Var<T>* b = l.bias(k);
     h.push_back(tanh(linear(h.back(), l.weight(k), b ? *b : Var<T>())));
   }
-  return h;
 }
 
 // Adds make_grad() as the gradient of input i (-1: none), only when the sweep wants it.
@@ -46,7 +79,9 @@ void gradient_chain(const MlpLayers<T>& l, const std::vector<Var<T>>& h, Eigen::
 
 template <typename T>
 void tanh_mlp_backward_recorded(const MlpLayers<T>& l, const Var<T>& g, GradSink<T>& s) {
-  const std::vector<Var<T>> h = hidden_layers(l);
+  typename Scratch<T>::Lease scratch;
+  std::vector<Var<T>>& h = scratch->h;
+  hidden_layers(l, h);
   Var<T> delta = g;
   for (int k = l.count(); k >= 1; --k) {
     const Var<T>& prev = h[std::size_t(k - 1)];
@@ -63,8 +98,10 @@ void tanh_mlp_backward_recorded(const MlpLayers<T>& l, const Var<T>& g, GradSink
 template <typename T>
 void input_gradient_backward_recorded(const MlpLayers<T>& l, const Var<T>& g, GradSink<T>& s) {
   const int L = l.count();
-  const std::vector<Var<T>> h = hidden_layers(l);
-  std::vector<Var<T>> a, d, hbar(static_cast<std::size_t>(L));
+  typename Scratch<T>::Lease scratch;
+  std::vector<Var<T>>&h = scratch->h, &a = scratch->a, &d = scratch->d, &hbar = scratch->hbar;
+  hidden_layers(l, h);
+  hbar.assign(std::size_t(L), Var<T>());
   gradient_chain(l, h, g.rows(), a, d);
   Var<T> abar = g;  // up the gradient chain
   for (int k = 1; k < L; ++k) {

@@ -6,6 +6,7 @@
 // one value per feature, repeated over the batch), a column (Rx1), or a scalar (1x1). The
 // gradient of a broadcast operand is summed back to its shape (sum_to).
 
+#include <initializer_list>
 #include <limits>
 #include <type_traits>
 #include <vector>
@@ -139,6 +140,10 @@ template <typename T>
 Var<T> pad_cols(const Var<T>& a, Eigen::Index start, Eigen::Index cols);
 template <typename T>
 Var<T> concat_cols(const std::vector<Var<T>>& parts);
+/// concat_cols of a braced list, e.g. concat_cols<T>({q, p}): no vector is built (a warmed-up
+/// step allocates nothing).
+template <typename T>
+Var<T> concat_cols(std::initializer_list<Var<T>> parts);
 
 // ---- operators -------------------------------------------------------------------------------
 template <typename T>

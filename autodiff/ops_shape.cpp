@@ -132,8 +132,10 @@ Var<T> pad_cols(const Var<T>& a, Eigen::Index start, Eigen::Index cols) {
   return Var<T>::of(node);
 }
 
+namespace {
+
 template <typename T>
-Var<T> concat_cols(const std::vector<Var<T>>& parts) {
+Var<T> concat_span(std::span<const Var<T>> parts) {
   HNN_AD_CHECK(!parts.empty(), "concat_cols: no inputs");
   Eigen::Index cols = 0;
   for (const Var<T>& p : parts) {
@@ -141,7 +143,7 @@ Var<T> concat_cols(const std::vector<Var<T>>& parts) {
                  parts[0].shape(), p.shape());
     cols += p.cols();
   }
-  Node<T>& node = detail::record<T>("concat_cols", std::span<const Var<T>>(parts),
+  Node<T>& node = detail::record<T>("concat_cols", parts,
                                     [](const Node<T>& n, const Var<T>& g, GradSink<T>& s) {
                                       Eigen::Index start = 0;
                                       for (int i = 0; i < int(n.inputs.size()); ++i) {
@@ -159,6 +161,18 @@ Var<T> concat_cols(const std::vector<Var<T>>& parts) {
   return Var<T>::of(node);
 }
 
+}  // namespace
+
+template <typename T>
+Var<T> concat_cols(const std::vector<Var<T>>& parts) {
+  return concat_span<T>(parts);
+}
+
+template <typename T>
+Var<T> concat_cols(std::initializer_list<Var<T>> parts) {
+  return concat_span<T>(std::span<const Var<T>>(parts.begin(), parts.size()));
+}
+
 #define HNN_INSTANTIATE(T)                                                 \
   template Var<T> sum(const Var<T>&);                                      \
   template Var<T> mean(const Var<T>&);                                     \
@@ -170,7 +184,8 @@ Var<T> concat_cols(const std::vector<Var<T>>& parts) {
   template Var<T> sum_to(const Var<T>&, Eigen::Index, Eigen::Index);       \
   template Var<T> slice_cols(const Var<T>&, Eigen::Index, Eigen::Index);   \
   template Var<T> pad_cols(const Var<T>&, Eigen::Index, Eigen::Index);     \
-  template Var<T> concat_cols(const std::vector<Var<T>>&);
+  template Var<T> concat_cols(const std::vector<Var<T>>&);                 \
+  template Var<T> concat_cols(std::initializer_list<Var<T>>);
 HNN_INSTANTIATE(float)
 HNN_INSTANTIATE(double)
 #undef HNN_INSTANTIATE

@@ -24,6 +24,15 @@ Var<T> Var<T>::constant(const Matrix<T>& value) {
 }
 
 template <typename T>
+Var<T> Var<T>::variable(const Matrix<T>& value) {
+  Node<T>& node = Tape<T>::current().push();
+  node.op = "variable";
+  node.value = value;
+  node.requires_grad = true;
+  return of(node);
+}
+
+template <typename T>
 Matrix<T>& Var<T>::mutable_value() {
   HNN_AD_CHECK(is_leaf(), "autodiff: only a leaf's value can be changed in place, not op '{}'",
                op());
@@ -40,8 +49,7 @@ T Var<T>::item() const {
 template <typename T>
 const Matrix<T>& Var<T>::grad() const {
   Node<T>& n = node();
-  HNN_AD_CHECK(n.is_leaf, "grad: only leaves accumulate gradients (op '{}'); use ad::grad()",
-               n.op);
+  HNN_AD_CHECK(n.is_leaf, "grad: only leaves accumulate gradients (op '{}'); use ad::grad()", n.op);
   if (!n.has_grad) {
     n.grad.setZero(n.value.rows(), n.value.cols());
     n.has_grad = true;

@@ -89,6 +89,11 @@ class Var {
   static Var leaf(Matrix<T> value, bool requires_grad = true);
   /// A scratch constant on the tape: no gradient, buffer recycled with the tape.
   static Var constant(const Matrix<T>& value);
+  /// A scratch variable on the tape: a constant() that requires gradients, so grad() can
+  /// differentiate with respect to it (a batch of states a field is differentiated in). Recycled
+  /// with the tape, so a warmed-up step allocates nothing, unlike a leaf(). Not a leaf:
+  /// backward() accumulates nothing into it.
+  static Var variable(const Matrix<T>& value);
   /// Wraps a node that is on the tape (used by backward formulas to refer to outputs).
   static Var of(const Node<T>& node) { return Var(const_cast<Node<T>*>(&node), nullptr); }
 

@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "autodiff/ops.h"
+#include "autodiff/tape.h"
 
 namespace hnn::nn {
 
@@ -158,22 +159,43 @@ void DynamicsModel<T>::check_input(const char* what, Index rows, Index cols) con
   }
 }
 
+namespace {
+
+// A constant on the tape whose value `fill` writes in place: the recycled node keeps its buffer
+// across steps, so a warmed-up step allocates nothing (a Matrix built for Var::constant would).
+template <typename T, typename Fill>
+ad::Var<T> tape_constant(Index rows, Index cols, const Fill& fill) {
+  ad::Node<T>& node = ad::Tape<T>::current().push();
+  node.op = "constant";
+  node.value.resize(rows, cols);
+  fill(node.value);
+  return ad::Var<T>::of(node);
+}
+
+// 1 / scale, one column per coordinate (1 x dim).
+template <typename T>
+ad::Var<T> inverse_scale(const std::vector<double>& scale) {
+  return tape_constant<T>(1, Index(scale.size()), [&](Matrix<T>& v) {
+    for (Index i = 0; i < v.cols(); ++i) v(0, i) = T(1.0 / scale[std::size_t(i)]);
+  });
+}
+
+}  // namespace
+
 template <typename T>
 ad::Var<T> DynamicsModel<T>::mlp_input(const ad::Var<T>& x) const {
   ad::Var<T> in = x;
   if (config_.angles > 0) {
     constexpr double kTwoPi = 2 * std::numbers::pi;
-    Matrix<T> shift = Matrix<T>::Zero(x.rows(), x.cols());
-    shift.leftCols(config_.angles) =
-        (x.value().leftCols(config_.angles).array() + T(std::numbers::pi)) / T(kTwoPi);
-    shift.leftCols(config_.angles) = shift.leftCols(config_.angles).array().floor() * T(kTwoPi);
-    in = in - ad::Var<T>::constant(shift);
+    const Index angles = config_.angles;
+    in = in - tape_constant<T>(x.rows(), x.cols(), [&](Matrix<T>& shift) {
+           shift.setZero();
+           shift.leftCols(angles) =
+               ((x.value().leftCols(angles).array() + T(std::numbers::pi)) / T(kTwoPi)).floor() *
+               T(kTwoPi);
+         });
   }
-  if (!config_.input_scale.empty()) {
-    const Eigen::Map<const Eigen::RowVectorXd> scale(config_.input_scale.data(),
-                                                     Eigen::Index(config_.input_scale.size()));
-    in = in * ad::Var<T>::constant(Matrix<T>(scale.cwiseInverse().template cast<T>()));
-  }
+  if (!config_.input_scale.empty()) in = in * inverse_scale<T>(config_.input_scale);
   return in;
 }
 
@@ -181,9 +203,7 @@ template <typename T>
 ad::Var<T> DynamicsModel<T>::input_gradient(const ad::Var<T>& x, Index column) const {
   const ad::Var<T> g = mlp_.input_gradient(mlp_input(x), column);
   if (config_.input_scale.empty()) return g;
-  const Eigen::Map<const Eigen::RowVectorXd> scale(config_.input_scale.data(),
-                                                   Eigen::Index(config_.input_scale.size()));
-  return g * ad::Var<T>::constant(Matrix<T>(scale.cwiseInverse().template cast<T>()));
+  return g * inverse_scale<T>(config_.input_scale);
 }
 
 template class DynamicsModel<float>;

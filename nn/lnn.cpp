@@ -94,8 +94,8 @@ ad::Var<T> Lnn<T>::time_derivative(const ad::Var<T>& x) const {
   const Index n = x.cols() / 2;
   ad::GradModeGuard inner(true);  // the Hessians need dL/dx on the tape even for values only
   // Differentiating with respect to x needs x to require gradients: a constant batch becomes a
-  // leaf (its copy is the only cost).
-  const ad::Var<T> in = x.requires_grad() ? x : ad::Var<T>::leaf(x.value());
+  // variable on the tape (its copy is the only cost; recycled, unlike a leaf).
+  const ad::Var<T> in = x.requires_grad() ? x : ad::Var<T>::variable(x.value());
   const ad::Var<T> dl = this->input_gradient(in, 0);
   ad::Var<T> dl_dv = ad::slice_cols(dl, n, n);
   if (this->config_.kinetic_prior != 0) {

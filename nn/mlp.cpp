@@ -42,16 +42,22 @@ ad::Var<T> fused_input_gradient(const ad::Var<T>& x, const std::vector<ad::Var<T
 // Any activation, through the engine's double backpropagation. Training (grad mode on) keeps the
 // derivative on the graph; under a NoGradGuard it is a value. Either way the forward pass must
 // be recorded to be differentiated, on x itself when x requires gradients (so that a loss
-// reaches whatever produced x) and on a leaf copy otherwise.
+// reaches whatever produced x) and on a variable copy on the tape otherwise.
 template <typename T>
 ad::Var<T> generic_input_gradient(const Mlp<T>& mlp, const ad::Var<T>& x, Index column) {
   const bool create_graph = ad::grad_enabled();
   ad::GradModeGuard record(true);
-  const ad::Var<T> input = x.requires_grad() ? x : ad::Var<T>::leaf(x.value());
+  const ad::Var<T> input = x.requires_grad() ? x : ad::Var<T>::variable(x.value());
   const ad::Var<T> out = mlp.forward(input);
   const ad::Var<T> y = out.cols() == 1 ? out : ad::slice_cols(out, column, 1);
   const ad::GradOptions options{.create_graph = create_graph, .allow_unused = true};
-  return ad::grad<T>({ad::sum(y)}, {input}, options)[0];
+  thread_local std::vector<ad::Var<T>> inputs, gradient;  // reused: no allocation per step
+  inputs.assign(1, input);
+  ad::grad_into(ad::sum(y), inputs, gradient, options);
+  const ad::Var<T> dx = gradient[0];
+  inputs.clear();  // release the handles (capacity stays)
+  gradient.clear();
+  return dx;
 }
 
 }  // namespace

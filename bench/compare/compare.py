@@ -28,8 +28,8 @@ OPENBLAS_OPENMP = "/usr/lib/x86_64-linux-gnu/openblas-openmp"
 MALLOC_TUNABLES = "glibc.malloc.mmap_threshold=16777216:glibc.malloc.trim_threshold=268435456"
 IMPLS = ("hnn", "pytorch", "libtorch")
 
-# name: (task, model, dtype, timing steps). Steps are short enough for a shared machine; the
-# spring loss check runs the full 2000 separately.
+# name: (task, model, dtype, timing steps[, options of every program]). Steps are short enough
+# for a shared machine; the spring loss check runs the full 2000 separately.
 CASES = {
     "spring-hnn-f32": ("spring", "hnn", "float32", 400),
     "spring-hnn-f64": ("spring", "hnn", "float64", 400),
@@ -42,8 +42,33 @@ CASES = {
     "pixel-hnn-f32": ("pixel", "hnn", "float32", 150),
     "pixel-baseline-f32": ("pixel", "baseline", "float32", 150),
 }
+# The peers' models at the peers' sizes (issue 18, "Speed"); PyTorch only (torch_peers.py).
+_DHNN = {"hidden": "256,256", "batch": 128, "lr": 5e-3, "weight-decay": 0}  # Sosanya & Greydanus
+_LNN = {"hidden": "600,600,600", "activation": "softplus", "batch": 512, "lr": 1e-3,
+        "weight-decay": 0}  # Cranmer et al.
+_LNN_SMALL = dict(_LNN, hidden="128,128")  # hnn's double-pendulum widths
+_ROLLOUT = {"loss": "rollout", "horizon": 4, "integrator": "leapfrog", "batch": 128, "lr": 1e-3,
+            "weight-decay": 1e-4}
+PEERS = {
+    "realpend-dhnn-f32": ("realpend", "dhnn", "float32", 400, _DHNN),
+    "realpend-dhnn-f64": ("realpend", "dhnn", "float64", 400, _DHNN),
+    "dblpend-lnn-f32": ("dblpend", "lnn", "float32", 40, _LNN),
+    "dblpend-lnn-f64": ("dblpend", "lnn", "float64", 40, _LNN),
+    "dblpend-lnn-small-f32": ("dblpend", "lnn", "float32", 200, _LNN_SMALL),
+    "dblpend-lnn-small-f64": ("dblpend", "lnn", "float64", 200, _LNN_SMALL),
+    "spring-rollout-f32": ("spring", "hnn", "float32", 200, _ROLLOUT),
+    "spring-rollout-f64": ("spring", "hnn", "float64", 200, _ROLLOUT),
+}
+CASES.update(PEERS)
 QUICK = ["spring-hnn-f32", "spring-hnn-f64", "twobody-hnn-f32", "threebody-hnn-f32",
          "pixel-hnn-f32"]
+GROUPS = {"all": list(CASES), "quick": QUICK, "peers": [c for c in PEERS if c.endswith("f32")]}
+
+
+def case_options(case):
+    """The options a case passes to every program besides task, model and dtype."""
+    extra = CASES[case][4] if len(CASES[case]) > 4 else {}
+    return [str(v) for key, value in extra.items() for v in (f"--{key}", value)]
 
 
 def log(*args):
@@ -116,7 +141,7 @@ def prepare(args, hnn, cases, out):
     prep.mkdir(parents=True, exist_ok=True)
     data, inits = {}, {}
     for name in cases:
-        task, model, dtype, _ = CASES[name]
+        task, model, dtype = CASES[name][:3]
         if task not in data:
             if task == "spring" and Path(args.spring_data).exists():
                 data[task] = {"path": str(Path(args.spring_data).resolve()), "n_train": 750,
@@ -126,20 +151,20 @@ def prepare(args, hnn, cases, out):
                 r = run_json([hnn, "--task", task, "--steps", 2, "--warmup", 1, "--window", 1,
                               "--save-data", path], env)
                 data[task] = {"path": str(path), "n_train": r["n_train"], "n_test": r["n_test"]}
-        init = prep / f"{task}-{model}-{dtype}.init"
+        init = prep / f"{name}.init"
         d = data[task]
         run_json([hnn, "--task", task, "--model", model, "--dtype", dtype, "--steps", 2,
                   "--warmup", 1, "--window", 1, "--data", d["path"], "--n-train", d["n_train"],
-                  "--n-test", d["n_test"], "--save-init", init], env)
+                  "--n-test", d["n_test"], "--save-init", init] + case_options(name), env)
         inits[name] = str(init)
     return data, inits
 
 
 def command(impl, progs, args, case, data, init, threads, steps):
-    task, model, dtype, _ = CASES[case]
+    task, model, dtype = CASES[case][:3]
     common = ["--task", task, "--model", model, "--dtype", dtype, "--threads", threads,
               "--steps", steps, "--data", data["path"], "--n-train", data["n_train"],
-              "--n-test", data["n_test"]]
+              "--n-test", data["n_test"]] + case_options(case)
     if impl == "hnn":
         return [progs["hnn"]] + common
     if impl == "pytorch":
@@ -160,6 +185,10 @@ def time_cases(args, progs, cases, data, inits):
                 order = impls[rnd % len(impls):] + impls[:rnd % len(impls)]
                 steps = max(20, int(CASES[case][3] * args.steps_scale))
                 for impl in order:
+                    if impl == "libtorch" and case in PEERS:
+                        if threads == args.threads[0] and rnd == 0:
+                            log(f"  {case}: no LibTorch program for the peers' cases (skipped)")
+                        continue
                     cmd = command(impl, progs, args, case, data[CASES[case][0]], inits[case],
                                   threads, steps)
                     load = os.getloadavg()[0]
@@ -184,7 +213,7 @@ def loss_check(args, progs, data, out):
     checks = []
     for dtype in ("float32", "float64"):
         case = f"spring-hnn-{'f32' if dtype == 'float32' else 'f64'}"
-        init = out / "inputs" / f"spring-hnn-{dtype}.init"
+        init = out / "inputs" / f"{case}.init"
         if not init.exists():
             continue
         for impl in (i for i in IMPLS if i in progs):
@@ -276,7 +305,7 @@ def main():
     ap.add_argument("--rounds", type=int, default=3)
     ap.add_argument("--threads", default="2,1", help="thread counts, e.g. 2,1")
     ap.add_argument("--cases", default="all",
-                    help="comma-separated names, 'all' or 'quick': " + ", ".join(CASES))
+                    help="comma-separated names, 'all', 'quick' or 'peers': " + ", ".join(CASES))
     ap.add_argument("--impls", default=",".join(IMPLS))
     ap.add_argument("--steps-scale", type=float, default=1.0, help="scales the timing steps")
     ap.add_argument("--spring-data",
@@ -291,8 +320,7 @@ def main():
     args = ap.parse_args()
     args.threads = [int(t) for t in args.threads.split(",")]
     args.impls = args.impls.split(",")
-    cases = (list(CASES) if args.cases == "all" else QUICK if args.cases == "quick"
-             else args.cases.split(","))
+    cases = GROUPS.get(args.cases) or args.cases.split(",")
     for c in cases:
         if c not in CASES:
             sys.exit(f"unknown case {c}; known: {', '.join(CASES)}")

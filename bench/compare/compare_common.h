@@ -6,6 +6,12 @@
 // Note [Same computation]: the three programs start from hnn's initial parameters (written by
 // --save-init, read by --init), train on the same data file, and draw minibatch rows from the
 // same splitmix64 stream (BatchIndices), so their final losses agree up to rounding.
+//
+// Note [Rollout windows]: the rollout loss (--loss rollout, spring only) trains on windows of
+// horizon + 1 consecutive states of one trajectory: the data file's splits hold 30-point
+// trajectories over t in [0, 3] one after the other (the spring task's stretches), and a
+// window's rows are its start, the horizon states after it and each step's length. Both sides
+// build the windows in the same order and draw window indices from BatchIndices.
 
 #include <algorithm>
 #include <chrono>
@@ -22,16 +28,21 @@ namespace hnn::compare {
 
 /// Command-line options of hnn_train_step and libtorch_step (torch_step.py has the same).
 struct Options {
-  std::string task = "spring";  // spring | twobody | threebody | pixel
-  std::string model = "hnn";    // hnn | baseline
+  std::string task = "spring";  // spring | twobody | threebody | pixel | realpend | dblpend
+  std::string model = "hnn";    // hnn | baseline | dhnn | lnn
   std::string dtype = "float32";
+  std::vector<long> hidden;             // hidden widths; empty: 200-200 (the HNN paper's)
+  std::string activation = "tanh";      // nn::Activation's names (tanh, softplus, ...)
+  std::string loss = "field";           // field: MSE of dx/dt; rollout: Note [Rollout windows]
+  int horizon = 4;                      // rollout: steps per window
+  std::string integrator = "leapfrog";  // rollout: the step (torch_step.py: leapfrog only)
   int threads = 1;
   int steps = -1;   // default per task (task_defaults)
   int warmup = -1;  // untimed steps; default steps / 10
   int window = -1;  // steps per timed window; default (steps - warmup) / 20
   int batch = -1;   // rows per step; 0: full batch
   std::uint64_t seed = 0;
-  double lr = 1e-3;
+  double lr = -1;                    // default 1e-3 (realpend: 5e-3)
   double weight_decay = -1;          // default 1e-4 (pixel: 1e-5 on the autoencoder)
   double dynamics_weight_decay = 0;  // pixel only: the latent model's L2 (PixelConfig's)
   std::string data, save_data, init, save_init;
@@ -45,7 +56,10 @@ inline long task_dim(const std::string& task) {
   if (task == "twobody") return 8;
   if (task == "threebody") return 12;
   if (task == "pixel") return 2 * 28 * 28;
-  throw std::invalid_argument("unknown task '" + task + "' (spring, twobody, threebody, pixel)");
+  if (task == "realpend") return 2;
+  if (task == "dblpend") return 4;
+  throw std::invalid_argument("unknown task '" + task +
+                              "' (spring, twobody, threebody, pixel, realpend, dblpend)");
 }
 
 /// hnn's name of a task (tasks::make_task).
@@ -53,21 +67,60 @@ inline std::string task_name(const std::string& task) {
   if (task == "twobody") return "two-body";
   if (task == "threebody") return "three-body";
   if (task == "pixel") return "pixel-pendulum";
+  if (task == "realpend") return "real-pendulum";
+  if (task == "dblpend") return "double-pendulum";
   return task;
+}
+
+/// Trajectories of the spring's data file (Note [Rollout windows]): points each, over [0, t_end].
+constexpr long kSpringPoints = 30;
+constexpr double kSpringTEnd = 3.0;
+
+/// "256,256" -> {256, 256}.
+inline std::vector<long> parse_widths(const std::string& text) {
+  std::vector<long> widths;
+  for (std::size_t start = 0; start <= text.size();) {
+    const std::size_t end = std::min(text.find(',', start), text.size());
+    widths.push_back(std::stol(text.substr(start, end - start)));
+    if (widths.back() < 1) throw std::invalid_argument("--hidden widths must be >= 1: " + text);
+    start = end + 1;
+  }
+  return widths;
+}
+
+/// The checks of task_defaults that concern the model and the loss.
+inline void check_model(const Options& o) {
+  if (o.model != "hnn" && o.model != "baseline" && o.model != "dhnn" && o.model != "lnn")
+    throw std::invalid_argument("--model must be hnn, baseline, dhnn or lnn");
+  if (o.dtype != "float32" && o.dtype != "float64")
+    throw std::invalid_argument("--dtype must be float32 or float64");
+  if (o.loss != "field" && o.loss != "rollout")
+    throw std::invalid_argument("--loss must be field or rollout");
+  if (o.loss == "rollout" && (o.task != "spring" || o.horizon < 1 || o.horizon >= kSpringPoints))
+    throw std::invalid_argument("--loss rollout runs on the spring task, horizon 1..29");
+  if ((o.model == "lnn" || o.model == "dhnn") && o.task == "pixel")
+    throw std::invalid_argument("the pixel task trains an hnn or a baseline");
 }
 
 /// Fills the per-task defaults: the batches of the paper's tasks, steps short enough for a
 /// comparison run (spring: the full 2000, so the losses match the reference's).
 inline void task_defaults(Options& o) {
   task_dim(o.task);
-  if (o.model != "hnn" && o.model != "baseline")
-    throw std::invalid_argument("--model must be hnn or baseline");
-  if (o.dtype != "float32" && o.dtype != "float64")
-    throw std::invalid_argument("--dtype must be float32 or float64");
+  check_model(o);
   const bool spring = o.task == "spring", pixel = o.task == "pixel";
-  if (o.batch < 0) o.batch = spring ? 0 : o.task == "threebody" ? 600 : 200;
+  // The peers' protocols: D-HNN (realpend) batch 128 at 5e-3, LNN (dblpend) batch 512, neither
+  // with weight decay; the rollout loss batch 128.
+  const bool peer = o.task == "realpend" || o.task == "dblpend";
+  if (o.batch < 0) {
+    o.batch = o.task == "realpend" || o.loss == "rollout" ? 128
+              : o.task == "dblpend"                       ? 512
+              : spring                                    ? 0
+              : o.task == "threebody"                     ? 600
+                                                          : 200;
+  }
   if (o.steps < 0) o.steps = spring ? 2000 : o.task == "twobody" ? 2000 : pixel ? 300 : 1000;
-  if (o.weight_decay < 0) o.weight_decay = pixel ? 1e-5 : 1e-4;
+  if (o.lr < 0) o.lr = o.task == "realpend" ? 5e-3 : 1e-3;
+  if (o.weight_decay < 0) o.weight_decay = peer ? 0 : pixel ? 1e-5 : 1e-4;
   if (o.warmup < 0) o.warmup = std::max(1, o.steps / 10);
   if (o.window < 0) o.window = std::max(1, (o.steps - o.warmup) / 20);
   if (spring && o.n_train < 0) o.n_train = o.n_test = 750;
@@ -81,8 +134,11 @@ inline Options parse_options(int argc, char** argv, const char* program) {
     const std::string key = argv[i];
     if (key == "--help" || key == "-h") {
       std::printf(
-          "%s --task spring|twobody|threebody|pixel --model hnn|baseline --dtype float32|float64\n"
-          "  [--threads N] [--steps N] [--warmup N] [--window N] [--batch N] [--seed N]\n"
+          "%s --task spring|twobody|threebody|pixel|realpend|dblpend\n"
+          "  --model hnn|baseline|dhnn|lnn --dtype float32|float64 [--hidden W,W,...]\n"
+          "  [--activation tanh|softplus|...] [--loss field|rollout --horizon K\n"
+          "  --integrator leapfrog] [--threads N] [--steps N] [--warmup N] [--window N]\n"
+          "  [--batch N] [--seed N]\n"
           "  [--lr X] [--weight-decay X] [--dynamics-weight-decay X] [--pixel-trials N]\n"
           "  [--data FILE --n-train N --n-test N] [--save-data FILE] [--init FILE]\n"
           "  [--save-init FILE]\nPrints one JSON line: ms_per_step (median over windows), "
@@ -98,6 +154,16 @@ inline Options parse_options(int argc, char** argv, const char* program) {
       o.model = v;
     else if (key == "--dtype")
       o.dtype = v;
+    else if (key == "--hidden")
+      o.hidden = parse_widths(v);
+    else if (key == "--activation")
+      o.activation = v;
+    else if (key == "--loss")
+      o.loss = v;
+    else if (key == "--horizon")
+      o.horizon = std::stoi(v);
+    else if (key == "--integrator")
+      o.integrator = v;
     else if (key == "--threads")
       o.threads = std::stoi(v);
     else if (key == "--steps")
@@ -257,6 +323,10 @@ inline void add_run_fields(nlohmann::json& j, const Options& o, const std::strin
   j["task"] = o.task;
   j["model"] = o.model;
   j["dtype"] = o.dtype;
+  j["hidden"] = o.hidden.empty() ? std::vector<long>{200, 200} : o.hidden;
+  j["activation"] = o.activation;
+  j["loss"] = o.loss;
+  if (o.loss == "rollout") j["horizon"] = o.horizon;
   j["threads"] = o.threads;
   j["steps"] = o.steps;
   j["warmup"] = o.warmup;

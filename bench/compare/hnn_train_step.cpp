@@ -1,6 +1,7 @@
 // hnn's side of the PyTorch / LibTorch comparison (bench/compare/README.md): trains one task's
-// model with the trainer's step (TapeScope, mse of time_derivative, grad, Adam) and prints one
-// JSON line with the median ms/step over timed windows and the final train/test losses.
+// model with the trainer's step (TapeScope, mse of time_derivative or the rollout loss through
+// tasks::integrator_step, grad, Adam) and prints one JSON line with the median ms/step over
+// timed windows and the final train/test losses.
 // Also writes the data and initial parameters that torch_step.py and libtorch_step load, so all
 // three run the same computation from the same start on the same batches (compare_common.h).
 
@@ -26,6 +27,8 @@
 #include "tasks/field_task.h"
 #include "tasks/pixel/model.h"
 #include "tasks/train/field_objective.h"
+#include "tasks/train/rollout_objective.h"
+#include "tasks/train/rollout_step.h"
 
 namespace {
 
@@ -72,27 +75,56 @@ cmp::Data build_data(const cmp::Options& o) {
   return {to_rows(d.train_x), to_rows(d.train_dxdt), to_rows(d.test_x), to_rows(d.test_dxdt)};
 }
 
+// A split as the step sees it: matrices with the same rows. The field loss takes {x, dx/dt}
+// (pixel: {pair, next pair}); the rollout loss {start, next_1..next_K, step_1..step_K}, the
+// tasks::RolloutWindows of the split's trajectories (Note [Rollout windows]).
+using Parts = std::vector<Batch>;
+
+Parts split_parts(const cmp::Options& o, const cmp::Rows& x, const cmp::Rows& dx) {
+  if (o.loss != "rollout") return {to_batch(x), to_batch(dx)};
+  const hnn::tasks::RolloutWindows w = hnn::tasks::rollout_windows(
+      hnn::tasks::regular_stretches(to_batch(x), cmp::kSpringPoints, cmp::kSpringTEnd), o.horizon);
+  Parts parts{w.start};
+  parts.insert(parts.end(), w.next.begin(), w.next.end());
+  parts.insert(parts.end(), w.step.begin(), w.step.end());
+  return parts;
+}
+
 // ---- models -------------------------------------------------------------------------------
+
+// The dynamics model of a task as the trainer builds it (FieldModelRun::fresh_model): the kind,
+// widths and activation asked for, and the task's angle coordinates and input scales.
+nn::DynamicsConfig dynamics_config(const cmp::Options& o) {
+  nn::DynamicsConfig config;
+  config.model = nn::parse_model_kind(o.model);
+  if (config.model == nn::ModelKind::kDhnn) config.field = nn::FieldType::kBoth;
+  config.dim = cmp::task_dim(o.task);
+  if (!o.hidden.empty()) config.hidden.assign(o.hidden.begin(), o.hidden.end());
+  config.activation = nn::parse_activation(o.activation);
+  const auto task = hnn::tasks::make_field_task(cmp::task_name(o.task));
+  config.angles = task->angle_coordinates();
+  config.input_scale = task->input_scale();
+  return config;
+}
 
 // One model behind a common face: its parameters, its loss on a batch, its Adam groups.
 template <typename T>
 class Model {
  public:
-  explicit Model(const cmp::Options& o) {
+  explicit Model(const cmp::Options& o)
+      : rollout_(o.loss == "rollout"),
+        integrator_(hnn::tasks::parse_rollout_integrator(o.integrator)) {
     std::mt19937_64 rng(o.seed);
-    const nn::ModelKind kind = o.model == "hnn" ? nn::ModelKind::kHnn : nn::ModelKind::kBaseline;
     if (o.task == "pixel") {
       pixel::PixelConfig config;
+      const auto kind = o.model == "hnn" ? nn::ModelKind::kHnn : nn::ModelKind::kBaseline;
       pixel_ = std::make_unique<pixel::PixelModel<T>>(config, kind, rng);
       for (const nn::NamedParameter<T>& p : pixel_->named_parameters()) {
         named_.push_back(p);
         (p.name.rfind("dynamics.", 0) == 0 ? dyn_ : ae_).push_back(p.var);
       }
     } else {
-      nn::DynamicsConfig config;
-      config.model = kind;
-      config.dim = cmp::task_dim(o.task);
-      dynamics_ = nn::make_model<T>(config, rng);
+      dynamics_ = nn::make_model<T>(dynamics_config(o), rng);
       named_ = dynamics_->named_parameters();
       for (const nn::NamedParameter<T>& p : named_) ae_.push_back(p.var);
     }
@@ -107,51 +139,70 @@ class Model {
     }
   }
 
-  /// The training loss of a batch, on the tape.
-  ad::Var<T> loss(const ad::Matrix<T>& x, const ad::Matrix<T>& dx) const {
+  /// The training loss of a batch (split_parts' layout), on the tape.
+  ad::Var<T> loss(const std::vector<ad::Matrix<T>>& parts) const {
+    if (rollout_) return rollout_loss(parts);
+    const ad::Var<T> x = ad::Var<T>::constant(parts[0]);
     if (pixel_) {
       return ad::mean(
-          pixel::pixel_loss(*pixel_, ad::Var<T>::constant(x), ad::Var<T>::constant(dx), kHnnWeight)
-              .total);
+          pixel::pixel_loss(*pixel_, x, ad::Var<T>::constant(parts[1]), kHnnWeight).total);
     }
-    return nn::mse(dynamics_->time_derivative(ad::Var<T>::constant(x)), ad::Var<T>::constant(dx));
+    return nn::mse(dynamics_->time_derivative(x), ad::Var<T>::constant(parts[1]));
   }
 
   /// One training step: the trainer's loop body.
-  void step(const ad::Matrix<T>& x, const ad::Matrix<T>& dx) {
+  void step(const std::vector<ad::Matrix<T>>& parts) {
     ad::TapeScope scope;  // everything this step records is recycled at the closing brace
-    const ad::Var<T> l = loss(x, dx);
-    const std::vector<ad::Var<T>> grads = ad::grad<T>({l}, params_);
+    const ad::Var<T> l = loss(parts);
+    ad::grad_into(l, params_, grads_);
     const auto split = std::ptrdiff_t(ae_.size());
     if (adam_dyn_) {
-      adam_main_->step({grads.begin(), grads.begin() + split});
-      adam_dyn_->step({grads.begin() + split, grads.end()});
+      adam_main_->step({grads_.begin(), grads_.begin() + split});
+      adam_dyn_->step({grads_.begin() + split, grads_.end()});
     } else {
-      adam_main_->step(grads);
+      adam_main_->step(grads_);
     }
   }
 
   /// The mean loss over a whole split, without a graph (chunks of 1000 rows).
-  double mean_loss(const Batch& x, const Batch& dx) const {
-    if (!pixel_) return hnn::tasks::field_mse(*dynamics_, x, dx);
+  double mean_loss(const Parts& split) const {
+    if (dynamics_ && !rollout_) return hnn::tasks::field_mse(*dynamics_, split[0], split[1]);
     double total = 0;
-    for (Eigen::Index s = 0; s < x.rows(); s += 1000) {
-      const Eigen::Index n = std::min<Eigen::Index>(1000, x.rows() - s);
+    std::vector<ad::Matrix<T>> chunk(split.size());
+    for (Eigen::Index s = 0; s < split[0].rows(); s += 1000) {
+      const Eigen::Index n = std::min<Eigen::Index>(1000, split[0].rows() - s);
       ad::TapeScope scope;
       ad::NoGradGuard values_only;
-      const ad::Matrix<T> xs = x.middleRows(s, n).cast<T>(), dxs = dx.middleRows(s, n).cast<T>();
-      total += double(loss(xs, dxs).item()) * double(n);
+      for (std::size_t i = 0; i < split.size(); ++i)
+        chunk[i] = split[i].middleRows(s, n).template cast<T>();
+      total += double(loss(chunk).item()) * double(n);
     }
-    return total / double(x.rows());
+    return total / double(split[0].rows());
   }
 
   const std::vector<nn::NamedParameter<T>>& named_parameters() const { return named_; }
 
  private:
+  // RolloutObjective's loss: from the start states, one integrator step per window step, the
+  // MSE of every reached state, averaged over the steps.
+  ad::Var<T> rollout_loss(const std::vector<ad::Matrix<T>>& parts) const {
+    const std::size_t horizon = (parts.size() - 1) / 2;
+    ad::Var<T> x = ad::Var<T>::constant(parts[0]), total;
+    for (std::size_t j = 0; j < horizon; ++j) {
+      const ad::Var<T> h = ad::Var<T>::constant(parts[1 + horizon + j]);
+      x = hnn::tasks::integrator_step(*dynamics_, x, h, integrator_);
+      const ad::Var<T> step_loss = nn::mse(x, ad::Var<T>::constant(parts[1 + j]));
+      total = total.defined() ? total + step_loss : step_loss;
+    }
+    return total * T(1.0 / double(horizon));
+  }
+
+  bool rollout_;
+  hnn::tasks::RolloutIntegrator integrator_;
   std::unique_ptr<nn::DynamicsModel<T>> dynamics_;
   std::unique_ptr<pixel::PixelModel<T>> pixel_;
   std::vector<nn::NamedParameter<T>> named_;
-  std::vector<ad::Var<T>> ae_, dyn_, params_;
+  std::vector<ad::Var<T>> ae_, dyn_, params_, grads_;
   std::unique_ptr<nn::Adam<T>> adam_main_, adam_dyn_;
 };
 
@@ -177,32 +228,40 @@ void save_init(const Model<T>& model, const std::string& path) {
 
 // ---- the timed run ------------------------------------------------------------------------
 
+// Rows `indices` of every part, into `batch` (sized once).
+template <typename T>
+void gather(const std::vector<ad::Matrix<T>>& parts, cmp::BatchIndices& indices, Eigen::Index rows,
+            std::vector<ad::Matrix<T>>& batch) {
+  batch.resize(parts.size());
+  for (std::size_t k = 0; k < parts.size(); ++k) batch[k].resize(rows, parts[k].cols());
+  for (Eigen::Index i = 0; i < rows; ++i) {
+    const Eigen::Index row = indices.next();
+    for (std::size_t k = 0; k < parts.size(); ++k) batch[k].row(i) = parts[k].row(row);
+  }
+}
+
 template <typename T>
 json run(const cmp::Options& o, const cmp::Data& data) {
   Model<T> model(o);
   if (!o.save_init.empty()) save_init(model, o.save_init);
-  const ad::Matrix<T> x = to_batch(data.train_x).cast<T>();
-  const ad::Matrix<T> dx = to_batch(data.train_dx).cast<T>();
-  const Eigen::Index batch = o.batch == 0 ? x.rows() : o.batch;
-  ad::Matrix<T> xb(batch, x.cols()), dxb(batch, dx.cols());
-  cmp::BatchIndices indices(o.seed, x.rows());
+  const Parts train = split_parts(o, data.train_x, data.train_dx);
+  std::vector<ad::Matrix<T>> parts, batch;
+  for (const Batch& p : train) parts.push_back(p.cast<T>());
+  cmp::BatchIndices indices(o.seed, parts[0].rows());
   cmp::StepTimer timer(o.steps, o.warmup, o.window);
   for (int step = 0; step < o.steps; ++step) {
     if (o.batch == 0) {
-      model.step(x, dx);
+      model.step(parts);
     } else {
-      for (Eigen::Index i = 0; i < batch; ++i) {
-        const Eigen::Index row = indices.next();
-        xb.row(i) = x.row(row);
-        dxb.row(i) = dx.row(row);
-      }
-      model.step(xb, dxb);
+      gather(parts, indices, o.batch, batch);
+      model.step(batch);
     }
     timer.tick(step + 1);
   }
   json result = timer.to_json();
-  result["train_loss"] = model.mean_loss(to_batch(data.train_x), to_batch(data.train_dx));
-  result["test_loss"] = model.mean_loss(to_batch(data.test_x), to_batch(data.test_dx));
+  result["train_loss"] = model.mean_loss(train);
+  result["test_loss"] = model.mean_loss(split_parts(o, data.test_x, data.test_dx));
+  result["train_rows"] = parts[0].rows();  // windows, for the rollout loss
   return result;
 }
 

@@ -191,6 +191,12 @@ json run(const cmp::Options& o, const cmp::Data& data) {
 int main(int argc, char** argv) {
   try {
     const cmp::Options o = cmp::parse_options(argc, argv, "libtorch_step");
+    if ((o.model != "hnn" && o.model != "baseline") || o.loss != "field" || !o.hidden.empty() ||
+        o.activation != "tanh" || o.task == "realpend" || o.task == "dblpend") {
+      throw std::invalid_argument(
+          "runs the HNN paper's cases only (hnn or baseline, 200-200 tanh, dx/dt loss); the "
+          "peers' cases (dhnn, lnn, rollout) are PyTorch's alone (torch_peers.py)");
+    }
     if (o.data.empty())
       throw std::invalid_argument("--data is required (hnn_train_step --save-data)");
     at::set_num_threads(o.threads);

@@ -9,7 +9,9 @@ windows after warm-up), train_loss and test_loss.
 Tasks: spring (2-dim, full batch), twobody (8-dim, batch 200), threebody (12-dim, batch 600):
 a 200-200 tanh MLP to a scalar H (HNN) or to dx/dt (baseline); pixel: the residual ReLU
 autoencoder 1568-200-200-200-2 and back with a 2-200-200-1 HNN (or 2-200-200-2 baseline) on
-the latent, loss mean(ae + cc + 0.1 hnn). Adam, lr 1e-3.
+the latent, loss mean(ae + cc + 0.1 hnn). Adam, lr 1e-3. The peers' cases (torch_peers.py):
+realpend with --model dhnn (batch 128, lr 5e-3), dblpend with --model lnn (batch 512), and the
+spring HNN with --loss rollout (leapfrog, batch 128), at the widths of --hidden.
 
 Run with Debian's interpreter (/usr/bin/python3 sees python3-torch). Exits 0 with a message
 when torch is missing.
@@ -23,23 +25,33 @@ import time
 try:
     import numpy as np
     import torch
+    import torch_peers
 except ImportError as error:  # the harness skips PyTorch when it is absent
     print(f"torch_step.py: PyTorch is not available ({error}); skipping", file=sys.stderr)
     sys.exit(0)
 
-DIMS = {"spring": 2, "twobody": 8, "threebody": 12, "pixel": 2 * 28 * 28}
+DIMS = {"spring": 2, "twobody": 8, "threebody": 12, "pixel": 2 * 28 * 28, "realpend": 2,
+        "dblpend": 4}
 HNN_WEIGHT = 0.1
 
 
 def task_defaults(a):
     """The per-task defaults of compare_common.h's task_defaults."""
     spring, pixel = a.task == "spring", a.task == "pixel"
+    peer = a.task in ("realpend", "dblpend")
+    if a.loss == "rollout" and (not spring or not 1 <= a.horizon < torch_peers.SPRING_POINTS
+                                or a.integrator != "leapfrog"):
+        sys.exit("torch_step.py: --loss rollout runs the spring task, leapfrog, horizon 1..29")
     if a.batch is None:
-        a.batch = 0 if spring else 600 if a.task == "threebody" else 200
+        a.batch = (128 if a.task == "realpend" or a.loss == "rollout" else 512
+                   if a.task == "dblpend" else 0 if spring else 600 if a.task == "threebody"
+                   else 200)
     if a.steps is None:
         a.steps = 2000 if spring or a.task == "twobody" else 300 if pixel else 1000
+    if a.lr is None:
+        a.lr = 5e-3 if a.task == "realpend" else 1e-3
     if a.weight_decay is None:
-        a.weight_decay = 1e-5 if pixel else 1e-4
+        a.weight_decay = 0.0 if peer else 1e-5 if pixel else 1e-4
     if a.warmup is None:
         a.warmup = max(1, a.steps // 10)
     if a.window is None:
@@ -197,25 +209,60 @@ class StepTimer:
                 "ms_min": w[0] if w else 0, "windows": n, "wall_s": self.end - self.start}
 
 
-def mean_loss(loss_fn, x, dx, chunk=1000):
+def mean_loss(loss_fn, parts, chunk=1000):
     """The mean loss over a whole split, in chunks, without a graph of the parameters."""
-    total = 0.0
-    for s in range(0, x.shape[0], chunk):
-        xs, dxs = x[s:s + chunk], dx[s:s + chunk]
-        total += loss_fn(xs, dxs, False).detach().double().item() * xs.shape[0]
-    return total / x.shape[0]
+    total, rows = 0.0, parts[0].shape[0]
+    for s in range(0, rows, chunk):
+        chunk_parts = [p[s:s + chunk] for p in parts]
+        total += loss_fn(chunk_parts, False).detach().double().item() * chunk_parts[0].shape[0]
+    return total / rows
+
+
+def build_model(a, dtype):
+    """The model, its Adam groups and its loss of a batch (a list of parts: [x, dx/dt], or the
+    rollout windows of torch_peers.rollout_parts)."""
+    hnn = a.model == "hnn"
+    if a.task == "pixel":
+        model = PixelModel(hnn).to(dtype)
+        groups = [{"params": model.ae.parameters(), "weight_decay": a.weight_decay},
+                  {"params": model.dyn.parameters(), "weight_decay": a.dynamics_weight_decay}]
+        return model, groups, lambda p, graph=True: model.loss_terms(p[0], p[1], graph).mean()
+    hidden = a.hidden or [200, 200]
+    if a.model == "dhnn":
+        model = torch_peers.Dhnn(DIMS[a.task], hidden, a.activation)
+    elif a.model == "lnn":
+        model = torch_peers.Lnn(DIMS[a.task], hidden, a.activation)
+    elif a.hidden or a.activation != "tanh":
+        sys.exit("torch_step.py: --hidden and --activation apply to dhnn and lnn")
+    else:
+        model = Dynamics(DIMS[a.task], hnn)
+    model = model.to(dtype)
+    groups = [{"params": model.parameters(), "weight_decay": a.weight_decay}]
+    if a.loss == "rollout":
+        return model, groups, lambda p, graph=True: torch_peers.rollout_loss(model, p, graph)
+    return model, groups, lambda p, graph=True: (model(p[0], graph) - p[1]).pow(2).mean()
+
+
+def split_parts(a, x, dx):
+    return torch_peers.rollout_parts(x, a.horizon) if a.loss == "rollout" else [x, dx]
 
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--task", choices=sorted(DIMS), default="spring")
-    ap.add_argument("--model", choices=["hnn", "baseline"], default="hnn")
+    ap.add_argument("--model", choices=["hnn", "baseline", "dhnn", "lnn"], default="hnn")
     ap.add_argument("--dtype", choices=["float32", "float64"], default="float32")
+    ap.add_argument("--hidden", type=lambda t: [int(w) for w in t.split(",")],
+                    help="hidden widths, e.g. 256,256 (dhnn, lnn)")
+    ap.add_argument("--activation", choices=sorted(torch_peers.ACTIVATIONS), default="tanh")
+    ap.add_argument("--loss", choices=["field", "rollout"], default="field")
+    ap.add_argument("--horizon", type=int, default=4)
+    ap.add_argument("--integrator", default="leapfrog")
     ap.add_argument("--threads", type=int, default=1)
     for name in ("steps", "warmup", "window", "batch", "n-train", "n-test"):
         ap.add_argument("--" + name, type=int)
     ap.add_argument("--seed", type=int, default=0)
-    ap.add_argument("--lr", type=float, default=1e-3)
+    ap.add_argument("--lr", type=float)
     ap.add_argument("--weight-decay", type=float)
     ap.add_argument("--dynamics-weight-decay", type=float, default=0.0)
     ap.add_argument("--data", required=True, help="raw float64 data (hnn_train_step --save-data)")
@@ -227,44 +274,34 @@ def main():
     dtype = {"float32": torch.float32, "float64": torch.float64}[a.dtype]
     x_tr, dx_tr, x_te, dx_te = (torch.tensor(v, dtype=dtype) for v in
                                 load_data(a.data, a.n_train, a.n_test, DIMS[a.task]))
-    hnn = a.model == "hnn"
     torch.manual_seed(a.seed)
-    if a.task == "pixel":
-        model = PixelModel(hnn).to(dtype)
-        groups = [{"params": model.ae.parameters(), "weight_decay": a.weight_decay},
-                  {"params": model.dyn.parameters(), "weight_decay": a.dynamics_weight_decay}]
-
-        def loss_fn(x, target, create_graph=True):
-            return model.loss_terms(x, target, create_graph).mean()
-    else:
-        model = Dynamics(DIMS[a.task], hnn).to(dtype)
-        groups = [{"params": model.parameters(), "weight_decay": a.weight_decay}]
-
-        def loss_fn(x, target, create_graph=True):
-            return (model(x, create_graph) - target).pow(2).mean()
+    model, groups, loss_fn = build_model(a, dtype)
     if a.init:
         load_init(model, a.init)
     opt = torch.optim.Adam(groups, lr=a.lr)
-    idx = None if a.batch == 0 else batch_indices(a.seed, x_tr.shape[0], a.steps * a.batch)
+    train, test = split_parts(a, x_tr, dx_tr), split_parts(a, x_te, dx_te)
+    rows = train[0].shape[0]
+    idx = None if a.batch == 0 else batch_indices(a.seed, rows, a.steps * a.batch)
 
     timer = StepTimer(a.steps, a.warmup, a.window)
     for step in range(a.steps):
         if idx is None:
-            xb, dxb = x_tr, dx_tr
+            batch = train
         else:
-            rows = idx[step * a.batch:(step + 1) * a.batch]
-            xb, dxb = x_tr.index_select(0, rows), dx_tr.index_select(0, rows)
-        loss = loss_fn(xb, dxb)
+            picked = idx[step * a.batch:(step + 1) * a.batch]
+            batch = [p.index_select(0, picked) for p in train]
+        loss = loss_fn(batch)
         opt.zero_grad(set_to_none=True)
         loss.backward()
         opt.step()
         timer.tick(step + 1)
 
     result = timer.to_json()
-    result.update(train_loss=mean_loss(loss_fn, x_tr, dx_tr), test_loss=mean_loss(loss_fn, x_te, dx_te),
+    result.update(train_loss=mean_loss(loss_fn, train), test_loss=mean_loss(loss_fn, test),
                   impl="pytorch", task=a.task, model=a.model, dtype=a.dtype,
+                  hidden=a.hidden or [200, 200], activation=a.activation, loss=a.loss,
                   threads=torch.get_num_threads(), steps=a.steps, warmup=a.warmup,
-                  window=a.window, batch=a.batch or x_tr.shape[0], n_train=x_tr.shape[0],
+                  window=a.window, batch=a.batch or rows, n_train=x_tr.shape[0], train_rows=rows,
                   n_test=x_te.shape[0], init=a.init or "own (torch orthogonal_)",
                   version=torch.__version__, blas_path=os.environ.get("LD_LIBRARY_PATH", ""))
     print(json.dumps(result))

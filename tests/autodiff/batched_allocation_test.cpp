@@ -53,6 +53,39 @@ TEST(BatchedAllocations, SolveAndItsDerivativesAllocateNothingAfterWarmUp) {
 #endif
 }
 
+// Heap allocations of `steps` steps after `warmup` of an LNN-shaped third-order path: a batch
+// as a tape variable, its per-row Hessian blocks by row_jacobian of a recorded gradient, the
+// parameter gradient through all of it.
+template <typename T>
+long AllocationsOfRowJacobianSteps(int warmup, int steps) {
+  const ad::Matrix<T> x0 = ad::testing::random_matrix(64, 4, 3).cast<T>();
+  const Var<T> w = Var<T>::leaf(ad::testing::random_matrix(4, 8, 4).cast<T>());
+  const std::vector<Var<T>> params = {w};
+  std::vector<Var<T>> grads;
+  long counted = 0;
+  for (int step = 0; step < warmup + steps; ++step) {
+    const long before = hnn::testing::allocation_count();
+    {
+      ad::TapeScope scope;
+      const Var<T> x = Var<T>::variable(x0);
+      const Var<T> l = ad::sum_cols(ad::softplus(ad::matmul(x, w)));
+      const Var<T> blocks = ad::row_hessian(l, x, {.create_graph = true});
+      ad::grad_into(ad::sum(ad::square(blocks)), params, grads);
+    }
+    if (step >= warmup) counted += hnn::testing::allocation_count() - before;
+  }
+  return counted;
+}
+
+TEST(BatchedAllocations, RowJacobianOfAVariableAllocatesNothingAfterWarmUp) {
+#if !HNN_COUNTS_ALLOCATIONS
+  GTEST_SKIP() << "malloc belongs to the sanitizer in this build";
+#else
+  EXPECT_EQ(AllocationsOfRowJacobianSteps<double>(3, 10), 0);
+  EXPECT_EQ(AllocationsOfRowJacobianSteps<float>(3, 10), 0);
+#endif
+}
+
 TEST(BatchedAllocations, TheCounterSeesAllocations) {
 #if !HNN_COUNTS_ALLOCATIONS
   GTEST_SKIP() << "malloc belongs to the sanitizer in this build";

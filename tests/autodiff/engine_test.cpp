@@ -105,6 +105,43 @@ TEST(Grad, SumsOverOutputsWeightedByGradOutputs) {
   EXPECT_TRUE(ad::grad<double>({s, s}, {x})[0].value().isApprox(MatrixD::Constant(2, 3, 2.0)));
 }
 
+TEST(Grad, IntoAReusedVectorWithAGradOutputMatchesGrad) {
+  ad::TapeScope scope;
+  const VarD x = VarD::leaf(random_matrix(2, 3, 7));
+  const VarD seed = VarD::constant(random_matrix(2, 3, 8));
+  std::vector<VarD> result;
+  ad::grad_into(ad::sin(x), {x}, result, {}, seed);
+  ASSERT_EQ(result.size(), 1u);
+  EXPECT_TRUE(
+      result[0].value().isApprox(ad::grad<double>({ad::sin(x)}, {x}, {}, {seed})[0].value()));
+}
+
+TEST(Variable, IsDifferentiableLikeALeafAndLivesOnTheTape) {
+  const MatrixD x0 = random_matrix(3, 2, 5);
+  const std::size_t before = ad::Tape<double>::current().size();
+  {
+    ad::TapeScope scope;
+    const VarD x = VarD::variable(x0);
+    EXPECT_TRUE(x.requires_grad());
+    EXPECT_FALSE(x.is_leaf());
+    const VarD dx = ad::grad<double>({ad::sum(ad::square(x))}, {x}, {.create_graph = true})[0];
+    EXPECT_TRUE(dx.value().isApprox(2 * x0));
+    // The derivative stays differentiable in x: d/dx sum((2x)^2) = 8x.
+    EXPECT_TRUE(ad::grad<double>({ad::sum(ad::square(dx))}, {x})[0].value().isApprox(8 * x0));
+  }
+  EXPECT_EQ(ad::Tape<double>::current().size(), before);  // recycled with the scope
+}
+
+TEST(ConcatCols, OfABracedListMatchesTheVectorForm) {
+  ad::TapeScope scope;
+  const VarD a = VarD::leaf(random_matrix(2, 1, 1)), b = VarD::leaf(random_matrix(2, 2, 2));
+  const VarD listed = ad::concat_cols<double>({a, b});
+  EXPECT_EQ(listed.value(), ad::concat_cols(std::vector<VarD>{a, b}).value());
+  const auto g = ad::grad<double>({ad::sum(listed * listed)}, {a, b});
+  EXPECT_TRUE(g[0].value().isApprox(2 * a.value()));
+  EXPECT_TRUE(g[1].value().isApprox(2 * b.value()));
+}
+
 TEST(Grad, SurvivesAVeryLongChain) {
   // 100000 nodes: the sweep and the tape are iterative, so nothing recurses this deep.
   ad::TapeScope scope;

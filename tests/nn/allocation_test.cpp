@@ -17,21 +17,18 @@ namespace nn = hnn::nn;
 
 namespace {
 
-// Heap allocations made by `steps` training steps of `kind` after `warmup` steps.
+// Heap allocations made by `steps` training steps of the model `config` makes, after `warmup`
+// steps, on a batch of `rows` random states.
 template <typename T>
-long allocations_per_steps(nn::ModelKind kind, int threads, long rows, int warmup, int steps,
-                           nn::FieldType field = nn::FieldType::kSolenoidal) {
+long allocations_per_steps(const nn::DynamicsConfig& config, int threads, long rows, int warmup,
+                           int steps) {
   ad::set_num_threads(threads);
   std::mt19937_64 rng(3);
-  nn::DynamicsConfig config;
-  config.model = kind;
-  config.field = field;
-  config.dim = 2;
-  config.hidden = {64, 64};
   const auto model = nn::make_model<T>(config, rng);
   nn::Adam<T> adam(model->parameters(), {.lr = 1e-3, .weight_decay = 1e-4});
-  const ad::Var<T> x = ad::Var<T>::leaf(nn::random_normal<T>(rows, 2, rng, 0, 1), false);
-  const ad::Var<T> target = ad::Var<T>::leaf(nn::random_normal<T>(rows, 2, rng, 0, 1), false);
+  const ad::Var<T> x = ad::Var<T>::leaf(nn::random_normal<T>(rows, config.dim, rng, 0, 1), false);
+  const ad::Var<T> target =
+      ad::Var<T>::leaf(nn::random_normal<T>(rows, config.dim, rng, 0, 1), false);
   std::vector<ad::Var<T>> grads;
   long counted = 0;
   for (int step = 0; step < warmup + steps; ++step) {
@@ -52,6 +49,24 @@ long allocations_per_steps(nn::ModelKind kind, int threads, long rows, int warmu
   return counted;
 }
 
+// A 2-dim model of `kind` with two hidden layers of 64.
+template <typename T>
+long allocations_per_steps(nn::ModelKind kind, int threads, long rows, int warmup, int steps,
+                           nn::FieldType field = nn::FieldType::kSolenoidal) {
+  return allocations_per_steps<T>({.model = kind, .dim = 2, .hidden = {64, 64}, .field = field},
+                                  threads, rows, warmup, steps);
+}
+
+// The double-pendulum task's LNN, small: 4 inputs, angles wrapped, velocities scaled by 1/10.
+nn::DynamicsConfig small_lnn(nn::Activation activation) {
+  return {.model = nn::ModelKind::kLnn,
+          .dim = 4,
+          .hidden = {32, 32},
+          .activation = activation,
+          .angles = 2,
+          .input_scale = {1, 1, 10, 10}};
+}
+
 }  // namespace
 
 TEST(Allocations, TrainingStepsAllocateNothingAfterWarmUp) {
@@ -69,6 +84,29 @@ TEST(Allocations, TrainingStepsAllocateNothingAfterWarmUp) {
                                              nn::FieldType::kBoth)),
               0)
         << "dissipative HNN (kBoth), double, " << threads << " thread(s)";
+  }
+}
+
+TEST(Allocations, DissipativeAndLagrangianStepsAllocateNothingAfterWarmUp) {
+#if !HNN_COUNTS_ALLOCATIONS
+  GTEST_SKIP() << "malloc belongs to the sanitizer in this build";
+#endif
+  const nn::DynamicsConfig dhnn{
+      .model = nn::ModelKind::kDhnn, .dim = 2, .hidden = {64, 64}, .field = nn::FieldType::kBoth};
+  for (int threads : {1, 2}) {
+    EXPECT_EQ(allocations_per_steps<float>(dhnn, threads, 128, 3, 20), 0)
+        << "D-HNN (kDhnn), float, " << threads << " thread(s)";
+    for (nn::Activation act : {nn::Activation::kTanh, nn::Activation::kSoftplus}) {
+      EXPECT_EQ(allocations_per_steps<double>(small_lnn(act), threads, 64, 3, 10), 0)
+          << "LNN, " << nn::to_string(act) << ", double, " << threads << " thread(s)";
+      EXPECT_EQ(allocations_per_steps<float>(small_lnn(act), threads, 64, 3, 10), 0)
+          << "LNN, " << nn::to_string(act) << ", float, " << threads << " thread(s)";
+    }
+    // Big enough that the elementwise ops split their rows across the threads too.
+    nn::DynamicsConfig wide = small_lnn(nn::Activation::kSoftplus);
+    wide.hidden = {128, 128};
+    EXPECT_EQ(allocations_per_steps<float>(wide, threads, 512, 2, 3), 0)
+        << "LNN 128-128, 512 rows, float, " << threads << " thread(s)";
   }
 }
 

@@ -17,8 +17,11 @@
 namespace hnn::tasks {
 namespace {
 
-// Heap allocations of `steps` rollout-loss steps (horizon 3, batch 32) after `warmup` steps.
-long allocations(RolloutIntegrator method, int warmup, int steps) {
+// Heap allocations of `steps` rollout-loss steps (horizon 3, batch 32) after `warmup` steps, on
+// `threads` threads.
+long allocations(RolloutIntegrator method, int warmup, int steps, int threads = 2) {
+  const int previous = ad::num_threads();
+  ad::set_num_threads(threads);
   std::mt19937_64 rng(3);
   std::vector<Stretch> stretches;
   Eigen::VectorXd t = Eigen::VectorXd::LinSpaced(8, 0.0, 3.5);
@@ -41,6 +44,7 @@ long allocations(RolloutIntegrator method, int warmup, int steps) {
     }
     if (step >= warmup) counted += hnn::testing::allocation_count() - before;
   }
+  ad::set_num_threads(previous);
   return counted;
 }
 
@@ -52,6 +56,7 @@ TEST(RolloutAllocations, ExplicitIntegratorStepsAllocateNothingAfterWarmUp) {
        {RolloutIntegrator::kLeapfrog, RolloutIntegrator::kYoshida4, RolloutIntegrator::kRk4}) {
     EXPECT_EQ(allocations(method, 3, 10), 0) << to_string(method);
   }
+  EXPECT_EQ(allocations(RolloutIntegrator::kLeapfrog, 3, 10, /*threads=*/1), 0) << "1 thread";
   // The midpoint's solve works on plain matrices: it allocates, and says how much.
   const long midpoint = allocations(RolloutIntegrator::kMidpoint, 3, 10);
   RecordProperty("midpoint_allocations_per_step", std::to_string(midpoint / 10));
