@@ -92,12 +92,20 @@ void validate(const DynamicsConfig& config) {
         "q, the first half)",
         config.angles, config.dim));
   }
+  for (Index i = 0; i < config.angles && !config.input_scale.empty(); ++i) {
+    if (config.input_scale[std::size_t(i)] != 1.0) {
+      throw std::invalid_argument(fmt::format(
+          "model: angle coordinate {} has input scale {}; an angle is seen as (cos, sin), "
+          "unscaled, so its scale must be 1",
+          i, config.input_scale[std::size_t(i)]));
+    }
+  }
 }
 
 MlpConfig mlp_config(const DynamicsConfig& config) {
   validate(config);
   MlpConfig mlp;
-  mlp.widths.push_back(config.dim);
+  mlp.widths.push_back(config.dim + config.angles);  // an angle is seen as (cos, sin)
   mlp.widths.insert(mlp.widths.end(), config.hidden.begin(), config.hidden.end());
   Index out = config.dim;
   if (learns_scalars(config.model)) out = config.field == FieldType::kBoth ? 2 : 1;
@@ -182,26 +190,37 @@ ad::Var<T> inverse_scale(const std::vector<double>& scale) {
 
 }  // namespace
 
+// Column blocks side by side; the parts vector is reused, so a step allocates nothing.
 template <typename T>
-ad::Var<T> DynamicsModel<T>::mlp_input(const ad::Var<T>& x) const {
-  ad::Var<T> in = x;
-  if (config_.angles > 0) {
-    constexpr double kTwoPi = 2 * std::numbers::pi;
-    const Index angles = config_.angles;
-    in = in - tape_constant<T>(x.rows(), x.cols(), [&](Matrix<T>& shift) {
-           shift.setZero();
-           shift.leftCols(angles) =
-               ((x.value().leftCols(angles).array() + T(std::numbers::pi)) / T(kTwoPi)).floor() *
-               T(kTwoPi);
-         });
-  }
-  if (!config_.input_scale.empty()) in = in * inverse_scale<T>(config_.input_scale);
-  return in;
+ad::Var<T> concat(std::initializer_list<ad::Var<T>> blocks) {
+  thread_local std::vector<ad::Var<T>> parts;
+  parts.assign(blocks);
+  const ad::Var<T> out = ad::concat_cols<T>(parts);
+  parts.clear();
+  return out;
 }
 
 template <typename T>
+ad::Var<T> DynamicsModel<T>::mlp_input(const ad::Var<T>& x) const {
+  ad::Var<T> in = x;
+  if (!config_.input_scale.empty()) in = in * inverse_scale<T>(config_.input_scale);
+  const Index a = config_.angles;
+  if (a == 0) return in;
+  const ad::Var<T> angle = ad::slice_cols(in, 0, a);
+  return concat<T>({ad::cos(angle), ad::sin(angle), ad::slice_cols(in, a, in.cols() - a)});
+}
+
+// The chain rule through the embedding: d/dθ = -sin θ d/dcos + cos θ d/dsin; then 1 / scale.
+template <typename T>
 ad::Var<T> DynamicsModel<T>::input_gradient(const ad::Var<T>& x, Index column) const {
-  const ad::Var<T> g = mlp_.input_gradient(mlp_input(x), column);
+  ad::Var<T> g = mlp_.input_gradient(mlp_input(x), column);
+  const Index a = config_.angles;
+  if (a > 0) {
+    const ad::Var<T> angle = ad::slice_cols(x, 0, a);
+    const ad::Var<T> d_angle =
+        ad::cos(angle) * ad::slice_cols(g, a, a) - ad::sin(angle) * ad::slice_cols(g, 0, a);
+    g = concat<T>({d_angle, ad::slice_cols(g, 2 * a, g.cols() - 2 * a)});
+  }
   if (config_.input_scale.empty()) return g;
   return g * inverse_scale<T>(config_.input_scale);
 }

@@ -48,8 +48,9 @@ struct DynamicsConfig {
   Activation activation = Activation::kTanh;
   Init init = Init::kOrthogonal;
   FieldType field = FieldType::kSolenoidal;  // HNN only; a kDhnn's must be kBoth
-  /// The first `angles` coordinates are angles: the MLP sees them wrapped to [-pi, pi), so a
-  /// model of a pendulum is periodic in them (the derivative of the wrap is 1).
+  /// The first `angles` coordinates are angles: the MLP sees each as (cos, sin), so a model is
+  /// smooth and periodic in them. (A wrap to [-pi, pi) would be periodic but jump at +-pi, where
+  /// a pendulum goes over the top: a learned energy would jump there too.)
   Index angles = 0;
   /// Empty, or one positive scale per coordinate: the MLP sees x / scale, so inputs of very
   /// different sizes (angular velocities of 10 beside angles of 1) do not saturate it.
@@ -98,12 +99,12 @@ class DynamicsModel : public Module<T> {
   DynamicsModel& operator=(DynamicsModel&&) noexcept = default;
   /// Throws ad::Error unless x is R x dim.
   void check_input(const char* what, Index rows, Index cols) const;
-  /// What the MLP sees: x with its angle coordinates wrapped to [-pi, pi), divided by the input
-  /// scales (x itself when there are neither). The wrap is a constant shift and the scale a
-  /// constant factor, so derivatives with respect to x pass through exactly.
+  /// What the MLP sees: x divided by the input scales, each angle coordinate as (cos, sin)
+  /// (columns: cos of the angles, sin of the angles, the other coordinates); x itself when
+  /// there are neither. On the tape, so derivatives of any order pass through.
   ad::Var<T> mlp_input(const ad::Var<T>& x) const;
   /// d mlp(mlp_input(x))[:, column] / dx: Mlp::input_gradient at the MLP's input, carried back
-  /// through the input scales (the chain rule's constant factor 1 / scale).
+  /// through the (cos, sin) of the angles and the input scales (R x dim).
   ad::Var<T> input_gradient(const ad::Var<T>& x, Index column) const;
 
   DynamicsConfig config_;

@@ -48,7 +48,7 @@ class FieldTask : public Task {
   /// Metrics of the task's own protocol from the evaluation's rollouts (a peer's), added to
   /// metrics.json; by default none.
   virtual void add_metrics(const Rollouts& rollouts, nlohmann::json& metrics) const;
-  /// How many leading coordinates are angles (the models see them wrapped); by default none.
+  /// How many leading coordinates are angles (the models see each as (cos, sin)); by default none.
   virtual Eigen::Index angle_coordinates() const { return 0; }
   /// The models' input scales (nn::DynamicsConfig::input_scale); by default none.
   virtual std::vector<double> input_scale() const { return {}; }
