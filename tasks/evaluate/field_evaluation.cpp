@@ -41,7 +41,7 @@ json rollout_metrics(const Rollouts& r, double threshold) {
   const nn::MeanStderr energy = energy_mse(r);
   const nn::MeanStderr state = state_mse(r);
   const RelativeError relative = relative_error(r, threshold);
-  const nn::MeanStderr floor = relative_error_floor(r);
+  const RelativeError floor = relative_error_floor(r, threshold);
   const bool measured = r.measured;
   json m = {{"rollouts", r.truth.size()},
             {"rollout_t_end", r.t.empty() ? 0.0 : r.t.back()},
@@ -56,9 +56,12 @@ json rollout_metrics(const Rollouts& r, double threshold) {
             {"relative_error_geomean", number(relative.geomean)},
             {"relative_error_geomean_se", number(relative.geomean_se)},
             {"relative_error_geomean_count", relative.count},
-            {"relative_error_floor", number(floor.mean)},
-            {"relative_error_floor_se", number(floor.std_error)},
+            {"relative_error_floor", number(floor.geomean)},
+            {"relative_error_floor_se", number(floor.geomean_se)},
             {"relative_error_floor_count", floor.count},
+            {"valid_prediction_time_floor", number(floor.valid_time)},
+            {"valid_prediction_time_floor_se", number(floor.valid_time_se)},
+            {"valid_prediction_floor_censored", floor.censored},
             {"valid_prediction_time", number(relative.valid_time)},
             {"valid_prediction_time_se", number(relative.valid_time_se)},
             {"valid_prediction_time_count", relative.count},

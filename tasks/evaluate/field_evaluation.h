@@ -33,7 +33,8 @@ double dissipation_share(const nn::DynamicsModel<double>& model, const Batch& x,
 /// The metrics of rollouts, each with its standard error and count (over the learned rollouts
 /// that did not fail): energy MSE (null for measured truth), state MSE, the relative error's
 /// geometric mean and its floor (Note [Perturbed truth], rollouts.h), the valid prediction time
-/// (until the relative error passes `threshold`), and at each horizon
+/// (until the relative error passes `threshold`) and the floor's (valid_prediction_time_floor:
+/// where the system's own sensitivity ends predictability), and at each horizon
 /// "state_mse_t<h>", "relative_error_t<h>" and "relative_error_floor_t<h>"; also "rollouts"
 /// (asked for), "n_rollouts" (that did not fail), "rollout_t_end" and "rollout_failures".
 nlohmann::json rollout_metrics(const Rollouts& rollouts, double threshold = 0.1);

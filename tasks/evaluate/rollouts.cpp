@@ -310,14 +310,18 @@ Eigen::VectorXd relative_state_error(const Eigen::MatrixXd& pred, const Eigen::M
       .matrix();
 }
 
-RelativeError relative_error(const Rollouts& r, double threshold) {
+namespace {
+
+// relative_error of `paths` against r.truth, leaving out the trajectories `skip` marks.
+RelativeError relative_error_of(const Rollouts& r, const std::vector<Eigen::MatrixXd>& paths,
+                                const std::vector<bool>& skip, double threshold) {
   std::vector<double> logs, valid;
   int censored = 0;
-  for (std::size_t i = 0; i < r.truth.size(); ++i) {
-    if (r.failed[i]) continue;
+  for (std::size_t i = 0; i < paths.size(); ++i) {
+    if (skip[i]) continue;
     const Eigen::MatrixXd& x = r.truth[i];
-    logs.push_back(mean_log_error(r.pred[i], x));
-    const Eigen::VectorXd error = relative_state_error(r.pred[i], x);
+    logs.push_back(mean_log_error(paths[i], x));
+    const Eigen::VectorXd error = relative_state_error(paths[i], x);
     double time = r.t.back() - r.t.front();
     bool passed = false;
     for (Eigen::Index k = 1; k < x.rows() && !passed; ++k) {
@@ -338,11 +342,14 @@ RelativeError relative_error(const Rollouts& r, double threshold) {
           .count = int(v.count)};
 }
 
-nn::MeanStderr relative_error_floor(const Rollouts& r) {
-  std::vector<double> logs;
-  for (std::size_t i = 0; i < r.floor.size(); ++i)
-    logs.push_back(mean_log_error(r.floor[i], r.truth[i]));
-  return geometric(logs);
+}  // namespace
+
+RelativeError relative_error(const Rollouts& r, double threshold) {
+  return relative_error_of(r, r.pred, r.failed, threshold);
+}
+
+RelativeError relative_error_floor(const Rollouts& r, double threshold) {
+  return relative_error_of(r, r.floor, std::vector<bool>(r.floor.size(), false), threshold);
 }
 
 std::vector<HorizonError> horizon_errors(const Rollouts& r) {

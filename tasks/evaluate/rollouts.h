@@ -129,10 +129,10 @@ struct RelativeError {
 };
 RelativeError relative_error(const Rollouts& rollouts, double threshold = 0.1);
 
-/// The geometric mean (and its standard error, as relative_error's) of the relative error the
-/// perturbed truth reaches against the truth over the same times: the floor of Note [Perturbed
-/// truth]. NaN with count 0 without a floor.
-nn::MeanStderr relative_error_floor(const Rollouts& rollouts);
+/// relative_error of the perturbed truth against the truth over the same times: the floor of
+/// Note [Perturbed truth] (its geometric mean), and the valid prediction time of a model whose
+/// only error were that of its start. NaN with count 0 without a floor.
+RelativeError relative_error_floor(const Rollouts& rollouts, double threshold = 0.1);
 
 /// The errors at one of RolloutConfig::horizons, over the learned rollouts that did not fail:
 /// the state MSE (mean over trajectories and components, standard error over trajectories), the

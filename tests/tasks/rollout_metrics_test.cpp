@@ -110,11 +110,12 @@ TEST(RelativeErrorFloor, IsThePerturbedTruthsErrorAndGrowsWithChaos) {
   RolloutConfig config{.trajectories = 10, .t_end = 5.0, .points = 51, .horizons = {0.25, 1.0}};
   const Rollouts r = make_rollouts(spring->truth(), still, x0, config);
   ASSERT_EQ(r.floor.size(), 10u);
-  const nn::MeanStderr floor = relative_error_floor(r);
-  EXPECT_EQ(floor.count, 10u);
-  EXPECT_GT(floor.mean, 1e-6);
-  EXPECT_LT(floor.mean, 1e-3);
-  EXPECT_GT(floor.std_error, 0);
+  const RelativeError floor = relative_error_floor(r);
+  EXPECT_EQ(floor.count, 10);
+  EXPECT_GT(floor.geomean, 1e-6);
+  EXPECT_LT(floor.geomean, 1e-3);
+  EXPECT_GT(floor.geomean_se, 0);
+  EXPECT_EQ(floor.censored, 10);  // never near 0.1
   // The horizons off the grid (0.25) are the truth's exact flow there.
   ASSERT_EQ(r.truth_at[0].rows(), 2);
   const Batch exact = *spring->truth().exact_flow(Batch(x0.row(0)), 0.25);
