@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The dissipative HNN beside the peers' published numbers (issue 18, part 1): the D-HNN paper's
 # damped spring and its real-pendulum protocol (80/20 in time, central differences, width 256,
-# batch 128, 5000 steps at 5e-3), each model on 3 seeds. Writes OUT/results.md.
+# batch 128, 5000 steps at 5e-3), each model on 3 seeds; 15 energy rollouts, as when
+# docs/families.md's figures were measured (the default is now 100). Writes OUT/results.md.
 # Usage: scripts/dhnn_results.sh [OUT]   (default results/dhnn; about 10 minutes on 2 cores)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -16,7 +17,8 @@ for seed in $(seq 0 $((seeds - 1))); do
       --out "$out/runs/damped-spring/$model/seed-$seed" >/dev/null
     "$hnn" train data --data data/lipson/real_pend_h_1.txt --model "$model" --seed "$seed" \
       --hidden 256 256 --batch 128 --steps 5000 --lr 5e-3 \
-      --hamiltonian "2.4*(1 - cos(o)) + v^2" --settings '{"energy_t_end": 20}' --quiet \
+      --hamiltonian "2.4*(1 - cos(o)) + v^2" --settings '{"energy_t_end": 20, "rollouts": 15}' \
+      --quiet \
       --out "$out/runs/real-pendulum/$model/seed-$seed" >/dev/null
   done
   echo "dhnn_results.sh: seed $seed done" >&2
