@@ -183,12 +183,12 @@ Rollouts follow_measured(const std::vector<Eigen::MatrixXd>& measured, const Lea
   Rollouts r;
   r.measured = true;
   r.t = physics::linspace(0.0, config.t_end, config.points);
-  r.horizons = config.horizons;
-  const Times times = merge_times(r.t, config.horizons);
-  HNN_TASKS_CHECK(times.all.size() == r.t.size(),
-                  "follow_measured: the horizons must be times of the grid (t_end {}, {} "
-                  "points)",
-                  config.t_end, config.points);
+  // Measurements exist at the grid's times only: each horizon moves to the nearest of them.
+  for (double h : config.horizons) {
+    const auto k = std::size_t(std::lround(h / config.t_end * (config.points - 1)));
+    r.horizons.push_back(r.t[std::min(k, r.t.size() - 1)]);
+  }
+  const Times times = merge_times(r.t, r.horizons);
   const Eigen::Index n = Eigen::Index(measured.size()), m = Eigen::Index(r.t.size());
   r.true_energy.setConstant(n, m, NAN);
   r.pred_energy.setConstant(n, m, NAN);

@@ -96,7 +96,8 @@ Rollouts make_rollouts(const physics::System& truth, const LearnedField& learned
 /// Rollouts along measured paths, for data without a true system: `measured[i]` holds the states
 /// at times linspace(0, config.t_end, config.points) after its first row (NaN rows where a
 /// sample is missing; the first row must be there), and the learned field is integrated from
-/// each first row. Energies are NaN and there is no floor.
+/// each first row. The horizons move to the nearest of those times (Rollouts::horizons says
+/// where). Energies are NaN and there is no floor.
 Rollouts follow_measured(const std::vector<Eigen::MatrixXd>& measured, const LearnedField& learned,
                          const RolloutConfig& config);
 

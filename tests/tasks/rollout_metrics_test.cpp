@@ -184,9 +184,11 @@ TEST(FollowMeasured, SkipsMissingSamplesAndHasNoFloorOrEnergy) {
   EXPECT_DOUBLE_EQ(m["valid_prediction_time"].get<double>(), 1.0);  // never passes 0.1
   EXPECT_EQ(m["state_mse_t0.2_count"], 3);
   EXPECT_EQ(m["state_mse_t0.5_count"], 2);  // not measured on path 1
-  // A horizon off the measured grid cannot be compared.
-  EXPECT_THROW(follow_measured(paths, exact, {.t_end = 1.0, .points = 11, .horizons = {0.25}}),
-               Error);
+  // A horizon off the measured grid moves to the nearest measured time.
+  const Rollouts moved =
+      follow_measured(paths, exact, {.t_end = 1.0, .points = 11, .horizons = {0.26}});
+  EXPECT_DOUBLE_EQ(moved.horizons[0], 0.3);
+  EXPECT_DOUBLE_EQ(moved.truth_at[0](0, 0), 1.3);
 }
 
 }  // namespace
