@@ -92,8 +92,8 @@ class FieldTask : public Task {
   std::unique_ptr<TaskRun> open(const RunSettings& settings) const override;
 };
 
-/// The settings "rollouts" and the span (`span_keys`: the names that set it, the first
-/// preferred) over `defaults`, for `task`'s messages: an integer in 1..max_rollouts and a finite
+/// The settings "rollouts" and the span (`span_keys`: the names that set it; giving two is an
+/// error) over `defaults`, for `task`'s messages: an integer in 1..max_rollouts and a finite
 /// t_end > 0; points keep the defaults' interval. The field tasks and the data task read their
 /// rollouts through it.
 RolloutConfig rollout_settings(const nlohmann::json& settings, RolloutConfig defaults,
