@@ -73,6 +73,10 @@ void validate(const DynamicsConfig& config) {
     throw std::invalid_argument(
         fmt::format("model: an LNN needs an even state dimension x = (q, v), got {}", config.dim));
   }
+  if (!(std::isfinite(config.kinetic_prior) && config.kinetic_prior >= 0)) {
+    throw std::invalid_argument(fmt::format(
+        "model: kinetic_prior must be a finite number >= 0, got {}", config.kinetic_prior));
+  }
   const bool scales_ok = std::all_of(config.input_scale.begin(), config.input_scale.end(),
                                      [](double s) { return s > 0 && std::isfinite(s); });
   if (!(config.input_scale.empty() || Index(config.input_scale.size()) == config.dim) ||

@@ -54,6 +54,12 @@ struct DynamicsConfig {
   /// Empty, or one positive scale per coordinate: the MLP sees x / scale, so inputs of very
   /// different sizes (angular velocities of 10 beside angles of 1) do not saturate it.
   std::vector<double> input_scale{};
+  /// LNN only: L = MLP(x~) + kinetic_prior · |v~|² / 2, where x~ is the MLP's input (scaled).
+  /// The term gives d²L/dv² a positive part from the start, so the Euler-Lagrange solve is
+  /// well-posed while the MLP is still random (a random MLP's blocks are near-singular at
+  /// many states, and the loss there is enormous); the MLP learns the rest, and can cancel
+  /// the term. 0: Cranmer et al.'s plain L = MLP.
+  double kinetic_prior = 1.0;
 };
 
 /// The MLP of a model: dim -> hidden... -> out, with out = dim for the baseline, the number of

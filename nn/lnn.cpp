@@ -35,20 +35,37 @@ ad::Var<T> hessian_block(const ad::Var<T>& jacobian, Index n, Index offset) {
   return block;
 }
 
+template <typename T>
+Matrix<T> prior_slope(const DynamicsConfig& config) {
+  const Index n = config.dim / 2;
+  Matrix<T> slope = Matrix<T>::Constant(1, n, T(config.kinetic_prior));
+  for (Index i = 0; i < n && !config.input_scale.empty(); ++i) {
+    const double s = config.input_scale[std::size_t(n + i)];
+    slope(0, i) /= T(s * s);
+  }
+  return slope;
+}
+
 }  // namespace
 
 template <typename T>
 Lnn<T>::Lnn(DynamicsConfig config, std::mt19937_64& rng)
-    : DynamicsModel<T>(require_lnn(config), Mlp<T>(mlp_config(require_lnn(config)), rng)) {}
+    : DynamicsModel<T>(require_lnn(config), Mlp<T>(mlp_config(require_lnn(config)), rng)),
+      prior_slope_(prior_slope<T>(config)) {}
 
 template <typename T>
 Lnn<T>::Lnn(DynamicsConfig config, Mlp<T> mlp)
-    : DynamicsModel<T>(require_lnn(config), std::move(mlp)) {}
+    : DynamicsModel<T>(require_lnn(config), std::move(mlp)), prior_slope_(prior_slope<T>(config)) {}
 
 template <typename T>
 ad::Var<T> Lnn<T>::lagrangian(const ad::Var<T>& x) const {
   this->check_input("lagrangian", x.rows(), x.cols());
-  return this->mlp_.forward(this->mlp_input(x));
+  const ad::Var<T> in = this->mlp_input(x);
+  const ad::Var<T> l = this->mlp_.forward(in);
+  if (this->config_.kinetic_prior == 0) return l;
+  const Index n = x.cols() / 2;
+  const T half_prior = T(0.5 * this->config_.kinetic_prior);
+  return l + ad::sum_cols(ad::square(ad::slice_cols(in, n, n))) * half_prior;
 }
 
 template <typename T>
@@ -59,8 +76,11 @@ Matrix<T> Lnn<T>::energy(const Matrix<T>& x) const {
   const Index n = x.cols() / 2;
   const ad::Var<T> in = ad::Var<T>::leaf(x);
   const Matrix<T> dl = this->input_gradient(in, 0).value();
+  // The prior term's share, v · (v · slope) - |v~|² prior / 2, is |v~|² prior / 2.
+  const Matrix<T> v2 = x.rightCols(n).array().square().matrix();
   return (x.rightCols(n).cwiseProduct(dl.rightCols(n)).rowwise().sum() -
-          this->mlp_.forward(this->mlp_input(in)).value())
+          this->mlp_.forward(this->mlp_input(in)).value() +
+          T(0.5) * (v2 * prior_slope_.transpose()))
       .eval();
 }
 
@@ -77,7 +97,10 @@ ad::Var<T> Lnn<T>::time_derivative(const ad::Var<T>& x) const {
   // leaf (its copy is the only cost).
   const ad::Var<T> in = x.requires_grad() ? x : ad::Var<T>::leaf(x.value());
   const ad::Var<T> dl = this->input_gradient(in, 0);
-  const ad::Var<T> dl_dv = ad::slice_cols(dl, n, n);
+  ad::Var<T> dl_dv = ad::slice_cols(dl, n, n);
+  if (this->config_.kinetic_prior != 0) {
+    dl_dv = dl_dv + ad::slice_cols(in, n, n) * ad::Var<T>::constant(prior_slope_);
+  }
   const ad::Var<T> jacobian = ad::row_jacobian(dl_dv, in, {.create_graph = record});
   ad::GradModeGuard outer(record);
   const ad::Var<T> v = ad::slice_cols(x, n, n);

@@ -195,6 +195,7 @@ class DataRun : public FieldModelRun {
           p_.config.loss.integrator, substeps_);
       LoopOptions o = loop;
       o.steps = s_.train.steps;
+      o.lr_schedule = s_.train.lr_schedule;
       o.record_every = s_.train.record_every;
       const TrainResult result = tasks::train(objective, o);
       keep(std::move(model));

@@ -138,6 +138,7 @@ class FieldRun : public FieldModelRun {
           loss_.integrator, substeps_);
       LoopOptions o = loop;
       o.steps = s_.train.steps;
+      o.lr_schedule = s_.train.lr_schedule;
       o.record_every = s_.train.record_every;
       const TrainResult result = tasks::train(objective, o);
       keep(std::move(model));
@@ -400,6 +401,7 @@ template <typename T>
 TrainResult train_model(nn::DynamicsModel<T>& model, const Dataset& data, const TrainConfig& config,
                         std::uint64_t seed, LoopOptions loop) {
   loop.steps = config.steps;
+  loop.lr_schedule = config.lr_schedule;
   loop.record_every = config.record_every;
   FieldObjective<T> objective(model, data, config.batch_size,
                               {.lr = config.learning_rate, .weight_decay = config.weight_decay},

@@ -62,6 +62,7 @@ TrainConfig train_config(const Task& task, const RunOptions& o) {
   if (o.hidden) c.hidden = *o.hidden;
   if (o.learning_rate) c.learning_rate = *o.learning_rate;
   if (o.weight_decay) c.weight_decay = *o.weight_decay;
+  if (o.lr_schedule) c.lr_schedule = *o.lr_schedule;
   return c;
 }
 
@@ -170,6 +171,7 @@ json RunSettings::to_json() const {
           {"hidden", join_widths(train.hidden)},
           {"learning_rate", train.learning_rate},
           {"weight_decay", train.weight_decay},
+          {"lr_schedule", to_string(train.lr_schedule)},
           {"data_file", data_file},
           {"task_settings", task_settings}};
 }
@@ -188,6 +190,8 @@ RunOptions options_from_json(const json& j, const std::string& where) {
     o.hidden = widths_from_json(j.at("hidden"));
     o.learning_rate = j.at("learning_rate").get<double>();
     if (j.contains("weight_decay")) o.weight_decay = j["weight_decay"].get<double>();
+    // Runs from before the schedules trained at a constant rate.
+    o.lr_schedule = parse_lr_schedule(j.value("lr_schedule", "constant"));
     o.data_file = j.value("data_file", "");
     o.task_settings = j.value("task_settings", json::object());
   } catch (const std::exception& e) {

@@ -27,6 +27,7 @@ struct TrainConfig {
   int batch_size = 0;  // 0: full batch
   double learning_rate = 1e-3;
   double weight_decay = 0.0;
+  LrSchedule lr_schedule = LrSchedule::kConstant;
   std::vector<int> hidden = {200, 200};
   int record_every = 0;  // loss-curve interval; 0 picks about 100 points
 };
@@ -78,6 +79,7 @@ struct RunOptions {
   std::optional<int> steps{}, batch_size{};
   std::optional<std::vector<int>> hidden{};  // overrides the preset's widths
   std::optional<double> learning_rate{}, weight_decay{};
+  std::optional<LrSchedule> lr_schedule{};
   std::string data_file{};
   nlohmann::json task_settings = nlohmann::json::object();
   std::filesystem::path out{};

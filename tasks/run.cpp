@@ -20,6 +20,7 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 
 LoopOptions loop_options(const RunOptions& o, const RunSettings& s, const RunFolder& folder) {
   return {.steps = s.train.steps,
+          .lr_schedule = s.train.lr_schedule,
           .record_every = s.train.record_every,
           .quiet = o.quiet,
           .label = fmt::format("{} {}", s.task, nn::to_string(s.model)),

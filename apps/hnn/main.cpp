@@ -66,12 +66,15 @@ void train_until_done_or_stopped(tasks::RunOptions o) {
 // `hnn train --resume DIR`: the settings are the checkpoint's; only options that cannot change
 // the result may be given again.
 tasks::RunOptions resumed_options(const CLI::App& cmd, const std::string& dir, bool quiet) {
-  for (const char* name :
-       {"task",          "--model", "--steps",      "--seed",       "--dtype",
-        "--preset",      "--batch", "--hidden",     "--lr",         "--data",
-        "--settings",    "--out",   "--coords",     "--momenta",    "--velocities",
-        "--derivatives", "--time",  "--trajectory", "--split",      "--test-fraction",
-        "--hamiltonian", "--loss",  "--horizon",    "--integrator", "--dt"}) {
+  for (const char* name : {"task",          "--model",       "--steps",
+                           "--seed",        "--dtype",       "--preset",
+                           "--batch",       "--hidden",      "--lr",
+                           "--lr-schedule", "--data",        "--settings",
+                           "--out",         "--coords",      "--momenta",
+                           "--velocities",  "--derivatives", "--time",
+                           "--trajectory",  "--split",       "--test-fraction",
+                           "--hamiltonian", "--loss",        "--horizon",
+                           "--integrator",  "--dt"}) {
     if (cmd.get_option(name)->count() > 0) {
       throw std::invalid_argument(fmt::format(
           "{} cannot be combined with --resume: a resumed run keeps its own settings", name));
@@ -111,7 +114,8 @@ void add_train_command(CLI::App& app) {
   auto checkpoint_every = std::make_shared<long>(0);
   cmd->add_option("task", options->task, "Task: " + task_list() + " (required unless --resume)");
   cmd->add_option("--model", *model,
-                  "hnn, baseline or dhnn (the dissipative HNN: H and a dissipation potential D)")
+                  "hnn, baseline, dhnn (the dissipative HNN: H and a dissipation potential D) or "
+                  "lnn (the Lagrangian NN: L(q, dq/dt))")
       ->check(CLI::IsMember(tasks::model_names()))
       ->capture_default_str();
   cmd->add_option("--steps", *steps, "Training steps (default: the paper's)")
@@ -135,6 +139,10 @@ void add_train_command(CLI::App& app) {
   cmd->add_option("--hidden", *hidden, "Hidden widths, e.g. --hidden 200 200")
       ->check(integer_in(1, tasks::kMaxWidth));
   cmd->add_option("--lr", *lr, "Adam learning rate (default 1e-3)")->check(positive_real());
+  auto lr_schedule = std::make_shared<std::string>();
+  cmd->add_option("--lr-schedule", *lr_schedule,
+                  "constant (the default) or cosine: decay from --lr towards 0 at the last step")
+      ->check(CLI::IsMember({"constant", "cosine"}));
   cmd->add_option("--data", options->data_file,
                   "The data task's file, or real-pendulum's measured data in its format");
   cmd->add_option("--out", options->out, "Run folder (default runs/TASK/MODEL)");
@@ -163,6 +171,7 @@ void add_train_command(CLI::App& app) {
     if (*steps > 0) o.steps = *steps;
     if (*batch >= 0) o.batch_size = *batch;
     if (*lr > 0) o.learning_rate = *lr;
+    if (!lr_schedule->empty()) o.lr_schedule = tasks::parse_lr_schedule(*lr_schedule);
     if (!hidden->empty()) o.hidden = *hidden;
     if (*checkpoint_every > 0) o.checkpoint_every = *checkpoint_every;
     if (o.out.empty()) o.out = std::filesystem::path("runs") / o.task / *model;

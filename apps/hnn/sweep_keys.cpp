@@ -35,6 +35,7 @@ constexpr KeyInfo kKeys[] = {
     {"steps", Kind::kPositiveInt},
     {"batch", Kind::kNonNegativeInt},
     {"lr", Kind::kPositiveReal},
+    {"lr-schedule", Kind::kLrSchedule},
     {"data", Kind::kFile},
     {"settings", Kind::kObject},
     {"checkpoint-every", Kind::kPositiveInt},
@@ -138,6 +139,8 @@ ordered_json checked_value(const KeyInfo& key, const ordered_json& v) {
       return one_of(v, tasks::preset_names(), "preset");
     case Kind::kSplit:
       return one_of(v, {"auto", "trajectories", "time"}, "split");
+    case Kind::kLrSchedule:
+      return one_of(v, {"constant", "cosine"}, "learning-rate schedule");
     case Kind::kLoss:
       return one_of(v, loss_names(), "loss");
     case Kind::kSeed:
@@ -262,6 +265,9 @@ void apply_value(const KeyInfo& key, const ordered_json& v, tasks::RunOptions& o
       break;
     case Kind::kPositiveReal:
       o.learning_rate = v.get<double>();
+      break;
+    case Kind::kLrSchedule:
+      o.lr_schedule = tasks::parse_lr_schedule(v.get<std::string>());
       break;
     default:
       if (key.name == "steps") o.steps = v.get<int>();

@@ -29,7 +29,8 @@ enum class Kind {
   kText,
   kSplit,
   kFraction,
-  kLoss
+  kLoss,
+  kLrSchedule
 };
 
 /// One key: its name, its kind, and the data task's settings key it fills (or "").

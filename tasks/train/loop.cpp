@@ -2,6 +2,8 @@
 
 #include <chrono>
 #include <cmath>
+#include <numbers>
+#include <stdexcept>
 
 #include "autodiff/grad.h"
 #include "autodiff/tape.h"
@@ -28,12 +30,17 @@ class GroupedAdam {
     for (const ParameterGroup<T>& group : groups) {
       check(group.adam);
       adams_.emplace_back(group.parameters, group.adam);
+      base_lr_.push_back(group.adam.lr);
       slices_.emplace_back().reserve(group.parameters.size());
       all_.insert(all_.end(), group.parameters.begin(), group.parameters.end());
     }
   }
   const std::vector<ad::Var<T>>& parameters() const { return all_; }
   std::vector<nn::Adam<T>>& adams() { return adams_; }
+  /// Each group's learning rate becomes its configured one times `factor`.
+  void scale_lr(double factor) {
+    for (std::size_t i = 0; i < adams_.size(); ++i) adams_[i].set_lr(base_lr_[i] * factor);
+  }
 
   static void check(const nn::AdamOptions& o) {
     HNN_TASKS_CHECK(o.lr > 0 && std::isfinite(o.lr), "learning rate must be positive, got {}",
@@ -54,6 +61,7 @@ class GroupedAdam {
 
  private:
   std::vector<nn::Adam<T>> adams_;
+  std::vector<double> base_lr_;
   std::vector<std::vector<ad::Var<T>>> slices_;
   std::vector<ad::Var<T>> all_;
 };
@@ -214,6 +222,8 @@ class Loop {
   }
 
   double step(long step) {
+    if (o_.lr_schedule != LrSchedule::kConstant)
+      adam_.scale_lr(lr_factor(o_.lr_schedule, step, o_.steps));
     return train_step(step, objective_, adam_, grads_, checkpoints_.where());
   }
 
@@ -256,6 +266,22 @@ class Loop {
 };
 
 }  // namespace
+
+std::string_view to_string(LrSchedule schedule) {
+  return schedule == LrSchedule::kCosine ? "cosine" : "constant";
+}
+
+LrSchedule parse_lr_schedule(std::string_view name) {
+  if (name == "constant") return LrSchedule::kConstant;
+  if (name == "cosine") return LrSchedule::kCosine;
+  throw std::invalid_argument(
+      fmt::format("unknown learning-rate schedule '{}' (expected constant or cosine)", name));
+}
+
+double lr_factor(LrSchedule schedule, long step, long steps) {
+  if (schedule == LrSchedule::kConstant || steps < 1) return 1.0;
+  return 0.5 * (1.0 + std::cos(std::numbers::pi * double(step - 1) / double(steps)));
+}
 
 template <typename T>
 TrainResult train(Objective<T>& objective, const LoopOptions& o) {

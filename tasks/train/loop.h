@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "tasks/report/run_folder.h"
@@ -51,8 +52,18 @@ struct StopSignal {
   std::atomic<bool> requested{false};
 };
 
+/// How the learning rate moves over a run: constant, or cosine decay from the set rate at step
+/// 1 towards 0 after the last step (Loshchilov & Hutter 2017, without restarts).
+enum class LrSchedule { kConstant, kCosine };
+std::string_view to_string(LrSchedule schedule);
+/// Inverse of to_string; throws std::invalid_argument naming the valid values.
+LrSchedule parse_lr_schedule(std::string_view name);
+/// The factor on the learning rate at `step` (1-based) of `steps`.
+double lr_factor(LrSchedule schedule, long step, long steps);
+
 struct LoopOptions {
   long steps = 0;
+  LrSchedule lr_schedule = LrSchedule::kConstant;
   long record_every = 0;  // loss-curve interval; 0: about 100 points
   bool quiet = false;     // no progress output
   std::string label = "train";

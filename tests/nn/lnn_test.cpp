@@ -25,14 +25,16 @@ MatrixD random_states(Eigen::Index rows, Eigen::Index dim, std::uint64_t seed, d
   return nn::random_uniform<double>(rows, dim, rng, -scale, scale);
 }
 
-// An LNN whose L has a clearly positive-definite d²L/dv² near the states tested: a small random
-// MLP plus nothing else would be indefinite, so tests pick seeds and states where the solve is
-// well posed and check the conditioning they rely on.
+// A small LNN, with the default kinetic prior or (kinetic_prior 0) the plain L = MLP of Cranmer
+// et al.: a small random MLP alone can be indefinite, so tests of it pick seeds and states where
+// the solve is well posed.
 nn::Lnn<double> small_lnn(Eigen::Index dim, std::uint64_t seed,
-                          nn::Activation act = nn::Activation::kTanh) {
+                          nn::Activation act = nn::Activation::kTanh, double kinetic_prior = 1.0) {
   std::mt19937_64 rng(seed);
-  return nn::Lnn<double>(
-      small_config(ModelKind::kLnn, dim, {12, 12}, nn::FieldType::kSolenoidal, act), rng);
+  nn::DynamicsConfig config =
+      small_config(ModelKind::kLnn, dim, {12, 12}, nn::FieldType::kSolenoidal, act);
+  config.kinetic_prior = kinetic_prior;
+  return nn::Lnn<double>(config, rng);
 }
 
 // The acceleration of row r by hand: ad::hessian of L at that row alone, solved by Eigen.
@@ -53,8 +55,11 @@ Eigen::VectorXd acceleration_by_hand(const nn::Lnn<double>& lnn, const MatrixD& 
 }  // namespace
 
 TEST(Lnn, AccelerationIsTheEulerLagrangeSolveOfEachRow) {
-  for (const nn::Activation act : {nn::Activation::kTanh, nn::Activation::kSoftplus}) {
-    const nn::Lnn<double> lnn = small_lnn(4, 11, act);
+  for (const auto& [act, prior] : {std::pair{nn::Activation::kTanh, 1.0},
+                                   {nn::Activation::kSoftplus, 1.0},
+                                   {nn::Activation::kTanh, 0.0},
+                                   {nn::Activation::kSoftplus, 0.0}}) {
+    const nn::Lnn<double> lnn = small_lnn(4, 11, act, prior);
     const MatrixD x = random_states(6, 4, 12);
     const MatrixD f = lnn.field(x);
     ASSERT_EQ(f.rows(), 6);
@@ -64,7 +69,7 @@ TEST(Lnn, AccelerationIsTheEulerLagrangeSolveOfEachRow) {
       const Eigen::VectorXd a = acceleration_by_hand(lnn, x, r);
       EXPECT_LT((f.row(r).rightCols(2).transpose() - a).cwiseAbs().maxCoeff(),
                 1e-9 * (1 + a.cwiseAbs().maxCoeff()))
-          << nn::to_string(act) << ", row " << r;
+          << nn::to_string(act) << ", prior " << prior << ", row " << r;
     }
     // The training path (recorded) gives the same values as the values-only one.
     ad::TapeScope scope;
@@ -118,12 +123,9 @@ TEST(Lnn, TrainingLossMatchesFiniteDifferencesUpToSecondOrder) {
   EXPECT_TRUE(second.ok) << second.worst << "\n" << second.log;
 }
 
-// dE/dt = dE/dx · f(x) = 0 at every state where the motion is defined (an identity of the
-// Euler-Lagrange equations), checked by a central difference of E along f; and E against a
-// moving state, to show the check has teeth.
-TEST(Lnn, ConservesItsLearnedEnergyAlongItsOwnFlow) {
-  const nn::Lnn<double> lnn = small_lnn(4, 31);
-  const MatrixD x = random_states(8, 4, 32);
+namespace {
+
+void expect_energy_conserved(const nn::Lnn<double>& lnn, const MatrixD& x) {
   const MatrixD f = lnn.field(x);
   const double eps = 1e-5;
   const MatrixD along = (lnn.energy(x + eps * f) - lnn.energy(x - eps * f)) / (2 * eps);
@@ -134,6 +136,23 @@ TEST(Lnn, ConservesItsLearnedEnergyAlongItsOwnFlow) {
     const double scale = 1 + f.row(r).norm();
     EXPECT_LT(std::abs(along(r, 0)), 1e-7 * scale) << "row " << r;
     EXPECT_GT(std::abs(across(r, 0)), 1e-4) << "row " << r;
+  }
+}
+
+}  // namespace
+
+// dE/dt = dE/dx · f(x) = 0 at every state where the motion is defined (an identity of the
+// Euler-Lagrange equations), checked by a central difference of E along f; and E against a
+// moving state, to show the check has teeth.
+TEST(Lnn, ConservesItsLearnedEnergyAlongItsOwnFlow) {
+  for (const bool scaled : {false, true}) {
+    std::mt19937_64 rng(31);
+    nn::DynamicsConfig config = small_config(ModelKind::kLnn, 4, {12, 12});
+    if (scaled) {  // as the double pendulum's: wrapped angles, velocities seen / 10
+      config.angles = 2;
+      config.input_scale = {1.0, 1.0, 10.0, 10.0};
+    }
+    expect_energy_conserved(nn::Lnn<double>(config, rng), random_states(8, 4, 32, scaled ? 5 : 1));
   }
 }
 
@@ -150,7 +169,7 @@ TEST(Lnn, SeesAnglesAsPeriodic) {
 }
 
 TEST(Lnn, ASingularVelocityHessianIsAClearError) {
-  nn::Lnn<double> lnn = small_lnn(4, 51);
+  nn::Lnn<double> lnn = small_lnn(4, 51, nn::Activation::kTanh, /*kinetic_prior=*/0.0);
   // L linear in v: d²L/dv² = 0 everywhere, so the motion is undefined.
   for (Var<double>& p : lnn.parameters()) p.mutable_value().setZero();
   const MatrixD x = random_states(5, 4, 52);
@@ -160,6 +179,26 @@ TEST(Lnn, ASingularVelocityHessianIsAClearError) {
   } catch (const std::exception& e) {
     EXPECT_NE(std::string(e.what()).find("singular"), std::string::npos) << e.what();
   }
+}
+
+// With the MLP zeroed, L is the prior alone, |v / scale|² / 2: a free particle, which neither
+// accelerates nor changes its energy |v / scale|² / 2.
+TEST(Lnn, TheKineticPriorAloneIsAFreeParticle) {
+  std::mt19937_64 rng(55);
+  nn::DynamicsConfig config = small_config(ModelKind::kLnn, 4, {6});
+  config.input_scale = {1.0, 1.0, 2.0, 4.0};
+  config.kinetic_prior = 3.0;
+  nn::Lnn<double> lnn(config, rng);
+  for (Var<double>& p : lnn.parameters()) p.mutable_value().setZero();
+  const MatrixD x = random_states(5, 4, 56, 2.0);
+  const MatrixD f = lnn.field(x);
+  EXPECT_EQ(f.leftCols(2), x.rightCols(2));
+  EXPECT_LT(f.rightCols(2).cwiseAbs().maxCoeff(), 1e-12);
+  const Eigen::VectorXd expected =
+      1.5 * ((x.col(2) / 2.0).array().square() + (x.col(3) / 4.0).array().square()).matrix();
+  EXPECT_LT((lnn.energy(x).col(0) - expected).cwiseAbs().maxCoeff(), 1e-12);
+  config.kinetic_prior = -1;
+  EXPECT_THROW(nn::Lnn<double>(config, rng), std::invalid_argument);
 }
 
 TEST(Lnn, CastsAndRefusesOtherConfigs) {

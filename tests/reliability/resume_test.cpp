@@ -32,13 +32,15 @@ struct Trained {
 // Trains a small spring HNN for `steps`; stops after `stop_at` (0: never) when `dir` is given;
 // resumes from `dir` when `resume` is set.
 template <typename T>
-Trained<T> train_spring(int batch, long stop_at, const fs::path& dir, bool resume) {
+Trained<T> train_spring(int batch, long stop_at, const fs::path& dir, bool resume,
+                        tasks::LrSchedule schedule = tasks::LrSchedule::kConstant) {
   const auto task = tasks::make_field_task("spring");
   const tasks::Dataset data = task->build_dataset(4);
   tasks::TrainConfig config = task->train_config();
   config.steps = 40;
   config.batch_size = batch;
   config.learning_rate = 1e-2;
+  config.lr_schedule = schedule;
   nn::DynamicsConfig model_config;
   model_config.hidden = {8};
   std::mt19937_64 init(4);
@@ -64,12 +66,13 @@ Trained<T> train_spring(int batch, long stop_at, const fs::path& dir, bool resum
 }
 
 template <typename T>
-void expect_resume_matches(int batch, long stop_at) {
+void expect_resume_matches(int batch, long stop_at,
+                           tasks::LrSchedule schedule = tasks::LrSchedule::kConstant) {
   const TempDir dir;
-  const Trained<T> whole = train_spring<T>(batch, 0, "", false);
-  train_spring<T>(batch, stop_at, dir / "checkpoint", false);
+  const Trained<T> whole = train_spring<T>(batch, 0, "", false, schedule);
+  train_spring<T>(batch, stop_at, dir / "checkpoint", false, schedule);
   EXPECT_EQ(tasks::read_train_state(dir / "checkpoint").step, stop_at);
-  const Trained<T> resumed = train_spring<T>(batch, 0, dir / "checkpoint", true);
+  const Trained<T> resumed = train_spring<T>(batch, 0, dir / "checkpoint", true, schedule);
   ASSERT_EQ(whole.params.size(), resumed.params.size());
   for (std::size_t i = 0; i < whole.params.size(); ++i) {
     EXPECT_EQ(whole.params[i], resumed.params[i]) << "parameter " << i << ", batch " << batch;
@@ -86,6 +89,15 @@ TEST(Resume, StoppedAndResumedEqualsUninterruptedBitForBit) {
   expect_resume_matches<double>(/*batch=*/25, /*stop_at=*/20);  // at one; minibatch generator
   expect_resume_matches<double>(/*batch=*/25, /*stop_at=*/1);
   expect_resume_matches<float>(/*batch=*/25, /*stop_at=*/33);
+}
+
+// The cosine schedule is a function of the step alone, so a resumed run follows it too; and it
+// is honoured: the run ends elsewhere than at a constant rate.
+TEST(Resume, ACosineScheduleResumesBitForBitAndChangesTheRun) {
+  expect_resume_matches<double>(/*batch=*/25, /*stop_at=*/20, tasks::LrSchedule::kCosine);
+  const auto constant = train_spring<double>(25, 0, "", false);
+  const auto cosine = train_spring<double>(25, 0, "", false, tasks::LrSchedule::kCosine);
+  EXPECT_NE(constant.params.front(), cosine.params.front());
 }
 
 TEST(Resume, RefusesACorruptCheckpointAndChangesNothing) {

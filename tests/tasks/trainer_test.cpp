@@ -231,6 +231,19 @@ TEST(Trainer, NonFiniteLossStopsWithTrainingDiverged) {
   }
 }
 
+// Cosine decay: the set rate at step 1, half of it half-way, nearly 0 at the last step.
+TEST(Trainer, CosineScheduleDecaysTheRateTowardsZero) {
+  using tasks::LrSchedule;
+  EXPECT_EQ(tasks::lr_factor(LrSchedule::kConstant, 77, 100), 1.0);
+  EXPECT_DOUBLE_EQ(tasks::lr_factor(LrSchedule::kCosine, 1, 100), 1.0);
+  EXPECT_NEAR(tasks::lr_factor(LrSchedule::kCosine, 51, 100), 0.5, 1e-12);
+  EXPECT_GT(tasks::lr_factor(LrSchedule::kCosine, 100, 100), 0);
+  EXPECT_LT(tasks::lr_factor(LrSchedule::kCosine, 100, 100), 1e-3);
+  EXPECT_EQ(tasks::parse_lr_schedule("cosine"), LrSchedule::kCosine);
+  EXPECT_EQ(tasks::to_string(LrSchedule::kConstant), "constant");
+  EXPECT_THROW(tasks::parse_lr_schedule("onecycle"), std::invalid_argument);
+}
+
 TEST(Trainer, RejectsImpossibleSettings) {
   const Dataset d = make_field_task("spring")->build_dataset(0);
   auto model = new_model<double>("hnn", 2, {16, 16}, 3);
