@@ -29,8 +29,11 @@ struct DataConfig {
   std::string hamiltonian;  ///< empty: no known H
   bool standardize = true;
   double threshold = 0.1;
-  int energy_rollouts = 15;
-  double energy_t_end = 0;   ///< 0: the held-out stretches' median duration
+  /// With a known H: the rollouts against it from test states ("rollouts", kDefaultRollouts
+  /// or as many test states as there are), over "t_end" (0: the held-out stretches' median
+  /// duration). "energy_rollouts" and "energy_t_end" are their older names.
+  int rollouts = kDefaultRollouts;
+  double t_end = 0;
   RolloutLossConfig loss{};  ///< dx/dt targets, or through an integrator
 };
 
@@ -38,7 +41,8 @@ const std::vector<std::string>& setting_names() {
   static const std::vector<std::string> names = {
       "coords",          "momenta",       "velocities", "derivatives", "time",        "trajectory",
       "split",           "test_fraction", "gap_factor", "hamiltonian", "standardize", "threshold",
-      "energy_rollouts", "energy_t_end",  "loss",       "horizon",     "integrator",  "dt"};
+      "rollouts",        "t_end",         "loss",       "horizon",     "integrator",  "dt",
+      "energy_rollouts", "energy_t_end"};
   return names;
 }
 
@@ -73,8 +77,6 @@ DataConfig data_config(const json& s) {
     c.hamiltonian = s.value("hamiltonian", std::string());
     c.standardize = s.value("standardize", true);
     c.threshold = s.value("threshold", c.threshold);
-    c.energy_rollouts = json_integer<int>(s.value("energy_rollouts", json(15)), "energy_rollouts");
-    c.energy_t_end = s.value("energy_t_end", 0.0);
   } catch (const json::exception& e) {
     throw Error(fmt::format("data: bad task settings {}: {}", s.dump(), e.what()));
   }
@@ -82,11 +84,17 @@ DataConfig data_config(const json& s) {
   HNN_TASKS_CHECK(c.threshold > 0 && c.threshold < 1,
                   "data: threshold {} is not between 0 and 1 (a relative state error)",
                   c.threshold);
-  HNN_TASKS_CHECK(c.energy_rollouts >= 1, "data: energy_rollouts must be at least 1, got {}",
-                  c.energy_rollouts);
-  HNN_TASKS_CHECK(c.energy_t_end >= 0 && std::isfinite(c.energy_t_end),
-                  "data: energy_t_end must be positive (or 0: the held-out duration), got {}",
-                  c.energy_t_end);
+  // The rollouts' settings as every field task reads them, under either name.
+  json rollouts = s;
+  if (s.contains("energy_rollouts")) {
+    HNN_TASKS_CHECK(!s.contains("rollouts"),
+                    "data: rollouts and energy_rollouts (its older name) are both given: give one");
+    rollouts["rollouts"] = s["energy_rollouts"];
+  }
+  const RolloutConfig r = rollout_settings(rollouts, {.t_end = 1.0, .points = 2}, "data",
+                                           kMaxRollouts, {"t_end", "energy_t_end"});
+  c.rollouts = r.trajectories;
+  if (s.contains("t_end") || s.contains("energy_t_end")) c.t_end = r.t_end;
   return c;
 }
 
@@ -303,16 +311,42 @@ class DataRun : public FieldModelRun {
     if (!p_.truth) {
       return {{"energy_mse", nullptr},
               {"energy_mse_se", nullptr},
-              {"energy_note", "no known Hamiltonian: give one with --hamiltonian EXPR"}};
+              {"energy_note", "no known Hamiltonian: give one with --hamiltonian EXPR"},
+              {"relative_error_floor_note",
+               "no known Hamiltonian to perturb (--hamiltonian EXPR gives "
+               "truth_rollout_relative_error_floor)"}};
     }
-    const double t_end = p_.config.energy_t_end > 0 ? p_.config.energy_t_end : held_out_duration();
-    const RolloutConfig config{.trajectories = p_.config.energy_rollouts, .t_end = t_end};
-    const Rollouts r = make_rollouts(
-        *p_.truth, file, spread_rows(p_.measured.data.test_x, config.trajectories), config);
-    const nn::MeanStderr e = energy_mse(r);
-    return {{"energy_mse", number(e.mean)}, {"energy_mse_se", number(e.std_error)},
-            {"n_rollouts", e.count},        {"rollout_failures", r.failures},
-            {"energy_t_end", t_end},        {"hamiltonian", p_.config.hamiltonian}};
+    const double t_end = p_.config.t_end > 0 ? p_.config.t_end : held_out_duration();
+    const Batch x0 = spread_rows(p_.measured.data.test_x, p_.config.rollouts);
+    // The floor's perturbation is 1e-4 in the model's (standardised) units.
+    const RolloutConfig config{
+        .trajectories = int(x0.rows()),
+        .t_end = t_end,
+        .perturbation_scale = {p_.units.scale.data(),
+                               p_.units.scale.data() + p_.units.scale.size()},
+        .seed = s_.seed + 2};
+    const Rollouts r = make_rollouts(*p_.truth, file, x0, config);
+    json m = rollout_metrics(r, p_.config.threshold);
+    // The held-out stretches' valid prediction time and state error keep their names; these
+    // are the rollouts against the known H.
+    json out = {{"energy_mse", m["energy_mse"]},
+                {"energy_mse_se", m["energy_mse_se"]},
+                {"energy_mse_count", m["energy_mse_count"]},
+                {"n_rollouts", m["n_rollouts"]},
+                {"rollouts", m["rollouts"]},
+                {"rollout_failures", r.failures},
+                {"energy_t_end", t_end},
+                {"hamiltonian", p_.config.hamiltonian}};
+    for (const char* key :
+         {"state_mse", "relative_error_geomean", "relative_error_floor", "valid_prediction_time"}) {
+      for (const char* suffix : {"", "_se", "_count"})
+        out[std::string("truth_rollout_") + key + suffix] = m[std::string(key) + suffix];
+    }
+    if (x0.rows() < p_.config.rollouts) {
+      out["rollouts_note"] = fmt::format("{} rollouts, not {}: the test set has {} states",
+                                         x0.rows(), p_.config.rollouts, x0.rows());
+    }
+    return out;
   }
 
   // Rows source,traj,t,x..,energy (with a known H),learned_h (with h).

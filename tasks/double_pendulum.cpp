@@ -19,7 +19,7 @@ namespace hnn::tasks {
 
 namespace {
 
-constexpr int kTrain = 20000, kTest = 5000, kMaxRollouts = 1000;
+constexpr int kTrain = 20000, kTest = 5000;
 constexpr double kMaxSpeed = 10.0, kEnergyScale = 29.4;
 
 class DoublePendulumTask : public FieldTask {
@@ -52,31 +52,13 @@ class DoublePendulumTask : public FieldTask {
     return {x.topRows(kTrain), dxdt.topRows(kTrain), x.bottomRows(kTest), dxdt.bottomRows(kTest)};
   }
   const physics::System& truth() const override { return pendulum_; }
-  Batch rollout_states(const Dataset&, std::mt19937_64& rng) const override {
-    return pendulum_.sample_initial_states(kMaxRollouts, rng);  // the run keeps the first N
+  Batch rollout_states(const Dataset&, int count, std::mt19937_64& rng) const override {
+    return pendulum_.sample_initial_states(count, rng);
   }
-  // 100 trajectories to T = 100 (the LNN paper used 40), sampled at 10 per unit of time.
+  // 100 trajectories to T = 100 (the LNN paper used 40), sampled at 10 per unit of time; the
+  // settings "rollouts" and "t_end" (FieldTask::rollout_config) for quick runs.
   RolloutConfig rollout_config() const override {
-    return {.trajectories = 100, .t_end = 100.0, .points = 1001, .rtol = 1e-9, .atol = 1e-11};
-  }
-  // Settings "rollouts" (1..1000) and "t_end" (> 0): fewer or shorter for quick runs.
-  RolloutConfig rollout_config(const nlohmann::json& s) const override {
-    RolloutConfig c = rollout_config();
-    c.trajectories =
-        json_integer<int>(s.value("rollouts", nlohmann::json(c.trajectories)), "rollouts");
-    c.t_end = s.value("t_end", c.t_end);
-    c.points = std::max(2, int(std::lround(c.t_end * 10)) + 1);
-    return c;
-  }
-  std::vector<std::string> own_setting_names() const override { return {"rollouts", "t_end"}; }
-  void check_task_settings(const nlohmann::json& s) const override {
-    FieldTask::check_task_settings(s);
-    const RolloutConfig c = rollout_config(s);
-    HNN_TASKS_CHECK(c.trajectories >= 1 && c.trajectories <= kMaxRollouts,
-                    "double-pendulum: rollouts must be in 1..{}, got {}", kMaxRollouts,
-                    c.trajectories);
-    HNN_TASKS_CHECK(std::isfinite(c.t_end) && c.t_end > 0,
-                    "double-pendulum: t_end must be a positive number, got {}", c.t_end);
+    return {.t_end = 100.0, .points = 1001, .rtol = 1e-9, .atol = 1e-11};
   }
   void add_metrics(const Rollouts& r, nlohmann::json& metrics) const override {
     const nn::MeanStderr e = energy_error_at_end(r, kEnergyScale);

@@ -7,6 +7,7 @@
 #include <fmt/ranges.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 
 #include "autodiff/tape.h"
@@ -109,6 +110,7 @@ class FieldRun : public FieldModelRun {
                       {.angles = task.angle_coordinates(), .input_scale = task.input_scale()}),
         task_(task),
         loss_(rollout_loss_config(s_.task_settings, task.name())) {
+    check_rollouts();
     stretches_ = task_.stretches(s_, data_);
     if (!loss_.rollout) return;
     // Checked here, before a run folder exists.
@@ -145,10 +147,23 @@ class FieldRun : public FieldModelRun {
   }
 
   nlohmann::json evaluate(const RunFolder* folder) const override {
-    const RolloutConfig config = task_.rollout_config(s_.task_settings);
-    FieldEvaluation e = evaluate_field_model(task_.truth(), dynamics(), data_,
-                                             rollout_states(config.trajectories), config);
+    const auto start = std::chrono::steady_clock::now();
+    const RolloutConfig config = evaluation_rollouts();
+    FieldEvaluation e =
+        task_.has_truth()
+            ? evaluate_field_model(task_.truth(), dynamics(), data_,
+                                   rollout_states(config.trajectories), config)
+            : evaluate_field_model(
+                  dynamics(), data_,
+                  follow_measured(measured_paths(config), learned_field(dynamics()), config));
+    if (config.trajectories < asked_rollouts_) {
+      e.metrics["rollouts_note"] =
+          fmt::format("{} rollouts, not {}: the data have {} distinct initial states",
+                      config.trajectories, asked_rollouts_, config.trajectories);
+    }
     task_.add_metrics(e.rollouts, e.metrics);
+    e.metrics["eval_seconds"] =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (folder) folder->write_text("rollout.csv", tasks::rollout_csv(e.rollouts));
     json m = e.metrics;
     m["training"] = loss_.to_json();
@@ -159,15 +174,24 @@ class FieldRun : public FieldModelRun {
   std::string rollout_csv(const RolloutRequest& r) const override {
     const auto integrator =
         physics::make_integrator(r.integrator, {.dt = r.dt, .rtol = r.rtol, .atol = r.rtol * 1e-3});
+    if (!task_.has_truth()) return measured_csv(r, *integrator);
     return rollout_paths_csv(task_.truth(), dynamics(), nn::to_string(s_.model),
                              rollout_states(r.trajectories), *integrator,
                              physics::linspace(0.0, r.t_end.value_or(rollout_span()), r.points));
   }
 
-  // The evaluation's states: a generator independent of the training data's draws.
+  // The evaluation's states: a generator independent of the training data's draws. Without a
+  // truth, the first states of the measured paths.
   physics::Batch rollout_states(int count) const override {
+    if (!task_.has_truth()) {
+      const std::vector<Eigen::MatrixXd> paths =
+          task_.measured_paths(s_, count, task_.rollout_config(s_.task_settings));
+      Batch x0(Eigen::Index(paths.size()), data_.test_x.cols());
+      for (std::size_t i = 0; i < paths.size(); ++i) x0.row(Eigen::Index(i)) = paths[i].row(0);
+      return x0;
+    }
     std::mt19937_64 rng(s_.seed + 1);
-    physics::Batch x0 = task_.rollout_states(data_, rng);
+    physics::Batch x0 = task_.rollout_states(data_, count, rng);
     x0.conservativeResize(std::min<Eigen::Index>(x0.rows(), count), Eigen::NoChange);
     return x0;
   }
@@ -175,6 +199,62 @@ class FieldRun : public FieldModelRun {
   double rollout_span() const override { return task_.rollout_config(s_.task_settings).t_end; }
 
  private:
+  // The run's rollouts: the task's with its settings, as many as the data can start (checked
+  // against an explicit "rollouts" in the constructor), the floor's draws from the run's seed.
+  RolloutConfig evaluation_rollouts() const {
+    RolloutConfig config = task_.rollout_config(s_.task_settings);
+    config.trajectories = std::min(config.trajectories, available_rollouts_);
+    config.seed = s_.seed + 2;
+    return config;
+  }
+
+  std::vector<Eigen::MatrixXd> measured_paths(const RolloutConfig& config) const {
+    return task_.measured_paths(s_, config.trajectories, config);
+  }
+
+  // How many rollouts the run's data can start, found before a run folder exists: a "rollouts"
+  // setting above it is an error naming both; the default is cut to it (and metrics say so).
+  void check_rollouts() {
+    const RolloutConfig config = task_.rollout_config(s_.task_settings);
+    asked_rollouts_ = config.trajectories;
+    available_rollouts_ = int(rollout_states(config.trajectories).rows());
+    HNN_TASKS_CHECK(available_rollouts_ > 0, "{}: no state to start a rollout from", task_.name());
+    HNN_TASKS_CHECK(
+        !s_.task_settings.contains("rollouts") || available_rollouts_ >= config.trajectories,
+        "{}: rollouts {} is more than the {} distinct initial states its data have", task_.name(),
+        config.trajectories, available_rollouts_);
+  }
+
+  // `hnn rollout` without a truth: the measured paths ("measured", missing samples left out) and
+  // the model's from their first states with the requested integrator.
+  std::string measured_csv(const RolloutRequest& r, const physics::Integrator& integrator) const {
+    RolloutConfig config = task_.rollout_config(s_.task_settings);
+    config.trajectories = std::min(r.trajectories, available_rollouts_);
+    const std::vector<Eigen::MatrixXd> paths = measured_paths(config);
+    const std::vector<double> t = physics::linspace(0.0, config.t_end, config.points);
+    const std::vector<double> model_t =
+        physics::linspace(0.0, r.t_end.value_or(config.t_end), r.points);
+    std::string csv = "source,traj,t";
+    for (Eigen::Index c = 0; c < data_.test_x.cols(); ++c) csv += fmt::format(",x_{}", c);
+    csv += ",energy,learned_h\n";
+    const auto rows = [&](std::string_view source, std::size_t traj, const Eigen::MatrixXd& x,
+                          const std::vector<double>& times) {
+      for (Eigen::Index k = 0; k < x.rows(); ++k) {
+        if (!x.row(k).allFinite()) continue;
+        csv += fmt::format("{},{},{:.9g}", source, traj, times[std::size_t(k)]);
+        for (Eigen::Index c = 0; c < x.cols(); ++c) csv += fmt::format(",{:.12g}", x(k, c));
+        csv += ",,\n";
+      }
+    };
+    const physics::VectorField field = learned_field(dynamics()).field;
+    for (std::size_t i = 0; i < paths.size(); ++i) {
+      rows("measured", i, paths[i], t);
+      rows(nn::to_string(s_.model), i,
+           integrator.integrate(field, Batch(paths[i].topRows(1)), model_t).path(0), model_t);
+    }
+    return csv;
+  }
+
   // The model (and the truth by leapfrog, one step per interval) from the first state of each
   // test stretch along its times. A rollout-trained model steps as it trained (its integrator
   // and sub-steps: the discrete map it learned); a derivative-trained one is integrated
@@ -202,6 +282,7 @@ class FieldRun : public FieldModelRun {
                                                          to_string(loss_.integrator), substeps_)
                                            : std::string("dopri5 (rtol 1e-9)");
     m["n_stretches"] = test.size();
+    if (!task_.has_truth()) return m;
     const Predictor leapfrog = [&](const Batch& x0, const Eigen::VectorXd& t) {
       const double interval = t.size() > 1 ? t(1) - t(0) : 1.0;
       const auto integrator = physics::make_integrator("leapfrog", {.dt = interval * (1 + 1e-9)});
@@ -248,13 +329,13 @@ class FieldRun : public FieldModelRun {
   std::optional<SplitStretches> stretches_;
   RolloutWindows train_windows_{}, test_windows_{};
   int substeps_ = 1;
+  int asked_rollouts_ = 0, available_rollouts_ = 0;
 };
 
 }  // namespace
 
 void FieldTask::add_metrics(const Rollouts&, nlohmann::json&) const {}
 
-RolloutConfig FieldTask::rollout_config(const nlohmann::json&) const { return rollout_config(); }
 std::vector<Stretch> regular_stretches(const Batch& x, int points, double t_end) {
   const std::vector<double> t = physics::linspace(0.0, t_end, points);
   const Eigen::VectorXd times = Eigen::Map<const Eigen::VectorXd>(t.data(), points);
@@ -292,15 +373,17 @@ std::optional<SplitStretches> FieldTask::stretches(const RunSettings&, const Dat
 }
 
 void FieldTask::check_task_settings(const nlohmann::json& settings) const {
-  const std::vector<std::string> own = own_setting_names();
+  const std::vector<std::string> own = own_setting_names(), rollouts = evaluation_setting_names();
   std::vector<std::string> known = rollout_setting_names();
   known.insert(known.end(), own.begin(), own.end());
+  known.insert(known.end(), rollouts.begin(), rollouts.end());
   for (const auto& [key, value] : settings.items()) {
     HNN_TASKS_CHECK(std::find(known.begin(), known.end(), key) != known.end(),
                     "task '{}' has no setting '{}' (known: {})", name(), key,
                     fmt::join(known, ", "));
   }
   rollout_loss_config(settings, name());
+  rollout_config(settings);
 }
 
 std::unique_ptr<TaskRun> FieldTask::open(const RunSettings& settings) const {

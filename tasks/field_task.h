@@ -38,13 +38,31 @@ class FieldTask : public Task {
   virtual Dataset build_dataset(const RunSettings& settings) const = 0;
   /// build_dataset with the task's default settings and this seed.
   Dataset build_dataset(std::uint64_t seed) const;
-  /// The ground truth for rollouts and energies (a fitted H for measured data).
+  /// The ground truth for rollouts and energies (a fitted H for measured data). A task without
+  /// one (has_truth() false) throws Error.
   virtual const physics::System& truth() const = 0;
-  /// Initial states of the energy-metric rollouts.
-  virtual Batch rollout_states(const Dataset& data, std::mt19937_64& rng) const = 0;
+  /// Whether truth() exists. A task on measured data without a true system says no and gives
+  /// measured_paths instead: its rollouts follow held-out measurements.
+  virtual bool has_truth() const { return true; }
+  /// Up to `count` measured paths on the times of `config` with their missing samples NaN (the
+  /// truth of follow_measured), for a task without a truth; by default none.
+  virtual std::vector<Eigen::MatrixXd> measured_paths(const RunSettings& settings, int count,
+                                                      const RolloutConfig& config) const;
+  /// Initial states of the evaluation's rollouts: `count` of them, or as many distinct ones as
+  /// the task's data have when that is fewer.
+  virtual Batch rollout_states(const Dataset& data, int count, std::mt19937_64& rng) const = 0;
+  /// The rollouts with the task's defaults: kDefaultRollouts of them unless the data have fewer
+  /// distinct initial states.
   virtual RolloutConfig rollout_config() const { return {}; }
-  /// The rollouts of a run with these task settings (a task may let them change the count).
-  virtual RolloutConfig rollout_config(const nlohmann::json& settings) const;
+  /// The rollouts of a run with its task settings applied: "rollouts" (1..kMaxRollouts) and the
+  /// span "rollout_t_end", or "t_end" where the task has no data setting of that name (spring
+  /// and pendulum do: their trajectories' span). A span changes the number of points to keep
+  /// the default's sampling interval; horizons beyond it are dropped. Throws Error naming the
+  /// task on a bad value.
+  RolloutConfig rollout_config(const nlohmann::json& settings) const;
+  /// Times at which the short-horizon errors are reported (RolloutConfig::horizons), for tasks
+  /// whose long-horizon errors chaos dominates; by default none.
+  virtual std::vector<double> short_horizons() const { return {}; }
   /// Metrics of the task's own protocol from the evaluation's rollouts (a peer's), added to
   /// metrics.json; by default none.
   virtual void add_metrics(const Rollouts& rollouts, nlohmann::json& metrics) const;
@@ -60,15 +78,27 @@ class FieldTask : public Task {
                                                   const Dataset& data) const;
   /// Position coordinates per body, for the position error (2 for the planar n-body tasks).
   virtual int coordinates_per_body() const { return 1; }
-  /// The task's own settings besides the rollout loss's (loss, horizon, integrator, dt).
+  /// The task's own settings besides the rollout loss's (loss, horizon, integrator, dt) and the
+  /// evaluation's (evaluation_setting_names).
   virtual std::vector<std::string> own_setting_names() const { return {}; }
-  /// Checks the rollout-loss keys and own_setting_names(); a task with settings of its own
-  /// checks their values in build_dataset (before a run folder exists).
+  /// The evaluation's rollouts: "rollouts", "t_end" unless own_setting_names() has it, and
+  /// "rollout_t_end".
+  std::vector<std::string> evaluation_setting_names() const;
+  /// Checks the rollout-loss keys, the rollouts' and own_setting_names(); a task with settings
+  /// of its own checks their values in build_dataset (before a run folder exists).
   void check_task_settings(const nlohmann::json& settings) const override;
 
   /// A FieldRun of this task; the task must outlive it.
   std::unique_ptr<TaskRun> open(const RunSettings& settings) const override;
 };
+
+/// The settings "rollouts" and the span (`span_keys`: the names that set it; giving two is an
+/// error) over `defaults`, for `task`'s messages: an integer in 1..max_rollouts and a finite
+/// t_end > 0; points keep the defaults' interval. The field tasks and the data task read their
+/// rollouts through it.
+RolloutConfig rollout_settings(const nlohmann::json& settings, RolloutConfig defaults,
+                               const std::string& task, int max_rollouts,
+                               const std::vector<std::string>& span_keys);
 
 /// make_task(name) as a FieldTask; throws Error when the task learns something else.
 std::unique_ptr<FieldTask> make_field_task(const std::string& name);

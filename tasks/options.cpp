@@ -100,6 +100,24 @@ std::string join_widths(const std::vector<int>& widths) {
   return s;
 }
 
+namespace {
+
+// Why a model that needs velocities does not fit a task, and which tasks it fits.
+std::string needs_velocities_note(nn::ModelKind model) {
+  if (!nn::needs_velocities(model)) return "";
+  std::vector<std::string> fits;
+  for (const std::string& name : task_names()) {
+    const std::vector<nn::ModelKind> models = make_task(name)->models();
+    if (std::find(models.begin(), models.end(), model) != models.end()) fits.push_back(name);
+  }
+  return fmt::format(
+      ": an {} learns L(q, dq/dt) from coordinates and their velocities, which "
+      "this task's states are not (tasks that have them: {})",
+      nn::to_string(model), fmt::join(fits, ", "));
+}
+
+}  // namespace
+
 RunSettings resolve(const Task& task, const RunOptions& o) {
   HNN_TASKS_CHECK(o.threads >= 1 && o.threads <= 256, "--threads must be 1..256, got {}",
                   o.threads);
@@ -114,8 +132,9 @@ RunSettings resolve(const Task& task, const RunOptions& o) {
   if (std::find(models.begin(), models.end(), o.model) == models.end()) {
     std::vector<std::string_view> names;
     for (nn::ModelKind m : models) names.push_back(nn::to_string(m));
-    throw Error(fmt::format("task '{}' does not train a {} model (its models: {})", task.name(),
-                            nn::to_string(o.model), fmt::join(names, ", ")));
+    throw Error(fmt::format("task '{}' does not train a {} model (its models: {}){}", task.name(),
+                            nn::to_string(o.model), fmt::join(names, ", "),
+                            needs_velocities_note(o.model)));
   }
   RunSettings s{.task = task.name(),
                 .model = o.model,

@@ -22,8 +22,8 @@ class OscillatorTask : public FieldTask {
     return SplitStretches{regular_stretches(data.train_x, o.points, o.t_end),
                           regular_stretches(data.test_x, o.points, o.t_end)};
   }
-  Batch rollout_states(const Dataset&, std::mt19937_64& rng) const override {
-    return physics::sample_evaluation_states(rollout_config().trajectories, rng);
+  Batch rollout_states(const Dataset&, int count, std::mt19937_64& rng) const override {
+    return physics::sample_evaluation_states(count, rng);
   }
 
  protected:

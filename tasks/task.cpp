@@ -23,6 +23,7 @@ const std::vector<std::pair<std::string, Factory>>& registry() {
       {"pixel-pendulum", make_pixel_pendulum_task},
       {"damped-spring", make_damped_spring_task},
       {"double-pendulum", make_double_pendulum_task},
+      {"real-double-pendulum", make_real_double_pendulum_task},
       {"data", make_data_task}};
   return tasks;
 }

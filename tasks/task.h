@@ -97,8 +97,9 @@ class Task {
 };
 
 /// The tasks by name: spring, pendulum, real-pendulum, two-body, three-body, pixel-pendulum (the
-/// paper's), damped-spring (the dissipative-HNN paper's) and data (a user's own file). Throws Error
-/// naming the known tasks for any other name.
+/// paper's), damped-spring (the dissipative-HNN paper's), double-pendulum (the LNN paper's),
+/// real-double-pendulum (measured) and data (a user's own file). Throws Error naming the known
+/// tasks for any other name.
 std::unique_ptr<Task> make_task(const std::string& name);
 std::vector<std::string> task_names();
 /// The paper's six: what `hnn reproduce` runs by default.

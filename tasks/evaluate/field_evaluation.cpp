@@ -37,24 +37,73 @@ double dissipation_share(const nn::DynamicsModel<double>& model, const Batch& x,
   return d / (solenoidal.squaredNorm() + d);
 }
 
+json rollout_metrics(const Rollouts& r, double threshold) {
+  const nn::MeanStderr energy = energy_mse(r);
+  const nn::MeanStderr state = state_mse(r);
+  const RelativeError relative = relative_error(r, threshold);
+  const RelativeError floor = relative_error_floor(r, threshold);
+  const bool measured = r.measured;
+  json m = {{"rollouts", r.truth.size()},
+            {"rollout_t_end", r.t.empty() ? 0.0 : r.t.back()},
+            {"n_rollouts", relative.count},
+            {"rollout_failures", r.failures},
+            {"energy_mse", measured ? json(nullptr) : number(energy.mean)},
+            {"energy_mse_se", measured ? json(nullptr) : number(energy.std_error)},
+            {"energy_mse_count", measured ? 0 : energy.count},
+            {"state_mse", number(state.mean)},
+            {"state_mse_se", number(state.std_error)},
+            {"state_mse_count", state.count},
+            {"relative_error_geomean", number(relative.geomean)},
+            {"relative_error_geomean_se", number(relative.geomean_se)},
+            {"relative_error_geomean_count", relative.count},
+            {"relative_error_floor", number(floor.geomean)},
+            {"relative_error_floor_se", number(floor.geomean_se)},
+            {"relative_error_floor_count", floor.count},
+            {"valid_prediction_time_floor", number(floor.valid_time)},
+            {"valid_prediction_time_floor_se", number(floor.valid_time_se)},
+            {"valid_prediction_floor_censored", floor.censored},
+            {"valid_prediction_time", number(relative.valid_time)},
+            {"valid_prediction_time_se", number(relative.valid_time_se)},
+            {"valid_prediction_time_count", relative.count},
+            {"valid_prediction_threshold", threshold},
+            {"valid_prediction_censored", relative.censored}};
+  if (r.floor.empty()) {
+    m["relative_error_floor_note"] = measured ? "no true system to perturb: the truth is measured"
+                                                " data"
+                                              : "no floor: the perturbation was 0";
+  }
+  for (const HorizonError& h : horizon_errors(r)) {
+    const std::string at = fmt::format("_t{:g}", h.t);
+    m["state_mse" + at] = number(h.state_mse.mean);
+    m["state_mse" + at + "_se"] = number(h.state_mse.std_error);
+    m["state_mse" + at + "_count"] = h.state_mse.count;
+    m["relative_error" + at] = number(h.relative_error.mean);
+    m["relative_error" + at + "_se"] = number(h.relative_error.std_error);
+    if (!r.floor.empty()) m["relative_error_floor" + at] = number(h.floor.mean);
+  }
+  return m;
+}
+
 FieldEvaluation evaluate_field_model(const physics::System& truth,
                                      const nn::DynamicsModel<double>& model, const Dataset& data,
                                      const Batch& x0, const RolloutConfig& config) {
   const auto start = std::chrono::steady_clock::now();
+  FieldEvaluation e = evaluate_field_model(model, data, make_rollouts(truth, model, x0, config));
+  e.metrics["eval_seconds"] =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return e;
+}
+
+FieldEvaluation evaluate_field_model(const nn::DynamicsModel<double>& model, const Dataset& data,
+                                     Rollouts rollouts) {
+  const auto start = std::chrono::steady_clock::now();
   const nn::MeanStderr train = loss_stats(model, data.train_x, data.train_dxdt);
   const nn::MeanStderr test = loss_stats(model, data.test_x, data.test_dxdt);
-  FieldEvaluation e{.rollouts = make_rollouts(truth, model, x0, config)};
-  const nn::MeanStderr energy = energy_mse(e.rollouts);
-  e.metrics = {{"train_loss", number(train.mean)},  {"train_loss_se", number(train.std_error)},
-               {"test_loss", number(test.mean)},    {"test_loss_se", number(test.std_error)},
-               {"energy_mse", number(energy.mean)}, {"energy_mse_se", number(energy.std_error)},
-               {"n_rollouts", energy.count},        {"rollout_failures", e.rollouts.failures},
-               {"n_train", data.train_x.rows()},    {"n_test", data.test_x.rows()}};
-  e.metrics["state_mse"] = number(state_mse(e.rollouts));
-  const RelativeError relative = relative_error(e.rollouts);
-  e.metrics["relative_error_geomean"] = number(relative.geomean);
-  e.metrics["valid_prediction_time"] = number(relative.valid_time);
-  e.metrics["valid_prediction_censored"] = relative.censored;
+  FieldEvaluation e{.rollouts = std::move(rollouts)};
+  e.metrics = {{"train_loss", number(train.mean)}, {"train_loss_se", number(train.std_error)},
+               {"test_loss", number(test.mean)},   {"test_loss_se", number(test.std_error)},
+               {"n_train", data.train_x.rows()},   {"n_test", data.test_x.rows()}};
+  e.metrics.update(rollout_metrics(e.rollouts));
   if (model.config().field == nn::FieldType::kBoth)
     e.metrics["dissipation_share"] = number(dissipation_share(model, data.test_x));
   e.metrics["train_r2"] = number(r_squared(train.mean, data.train_dxdt));

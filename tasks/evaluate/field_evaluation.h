@@ -30,10 +30,22 @@ double r_squared(double mse, const Batch& dxdt);
 double dissipation_share(const nn::DynamicsModel<double>& model, const Batch& x,
                          const std::function<Batch(const Batch&)>& to_data_units = {});
 
+/// The metrics of rollouts, each with its standard error and count (over the learned rollouts
+/// that did not fail): energy MSE (null for measured truth), state MSE, the relative error's
+/// geometric mean and its floor (Note [Perturbed truth], rollouts.h), the valid prediction time
+/// (until the relative error passes `threshold`) and the floor's (valid_prediction_time_floor:
+/// where the system's own sensitivity ends predictability), and at each horizon
+/// "state_mse_t<h>", "relative_error_t<h>" and "relative_error_floor_t<h>"; also "rollouts"
+/// (asked for), "n_rollouts" (that did not fail), "rollout_t_end" and "rollout_failures".
+nlohmann::json rollout_metrics(const Rollouts& rollouts, double threshold = 0.1);
+
 /// Evaluates `model` on `data` and on rollouts from `x0` against `truth`.
 FieldEvaluation evaluate_field_model(const physics::System& truth,
                                      const nn::DynamicsModel<double>& model, const Dataset& data,
                                      const Batch& x0, const RolloutConfig& config);
+/// The same with rollouts made already (along measured paths, say).
+FieldEvaluation evaluate_field_model(const nn::DynamicsModel<double>& model, const Dataset& data,
+                                     Rollouts rollouts);
 
 /// rollout.csv: traj,t,true_0..,pred_0..,true_energy,pred_energy,learned_h.
 std::string rollout_csv(const Rollouts& rollouts);

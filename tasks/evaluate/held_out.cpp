@@ -68,7 +68,14 @@ void valid_time(const Units& units, double threshold, HeldOutRollout& r) {
 
 nlohmann::json summary_json(const std::string& name, const std::vector<double>& values) {
   const Summary s = summarise(values);
-  return {{name, number(s.mean)}, {name + "_se", number(s.se)}};
+  return {{name, number(s.mean)}, {name + "_se", number(s.se)}, {name + "_count", values.size()}};
+}
+
+// Mean over the points after the start of log e, e the relative state error in the model's units.
+double mean_log_error(const Units& units, const HeldOutRollout& r) {
+  const Eigen::VectorXd e = relative_state_error(units.to_model(r.pred), units.to_model(r.truth));
+  if (e.size() < 2) return NAN;
+  return e.tail(e.size() - 1).array().max(1e-300).log().mean();
 }
 
 }  // namespace
@@ -77,7 +84,7 @@ HeldOutEvaluation evaluate_held_out(const LearnedField& model, const Units& unit
                                     const std::vector<HeldOut>& held_out, Eigen::Index coordinates,
                                     const Batch& train_z, const HeldOutOptions& options) {
   HeldOutEvaluation e;
-  std::vector<double> mse, valid, drift, drift_relative;
+  std::vector<double> mse, valid, drift, drift_relative, logs;
   double sum = 0, count = 0, energy_sum = 0, energy_count = 0;
   int censored = 0;
   std::vector<std::string> failures;
@@ -107,6 +114,7 @@ HeldOutEvaluation evaluate_held_out(const LearnedField& model, const Units& unit
       count += double(sq.size());
       valid.push_back(r.valid_time);
       censored += r.censored ? 1 : 0;
+      logs.push_back(mean_log_error(units, r));
       if (r.pred_energy.size() > 0) {
         energy_sum += (r.pred_energy - r.true_energy).squaredNorm();
         energy_count += double(r.pred_energy.size());
@@ -119,8 +127,14 @@ HeldOutEvaluation evaluate_held_out(const LearnedField& model, const Units& unit
     }
     e.rollouts.push_back(std::move(r));
   }
+  const Summary log = summarise(logs);
+  const double geomean = std::exp(log.mean);
   e.metrics = {{"coordinate_mse", number(count > 0 ? sum / count : NAN)},
                {"coordinate_mse_se", number(summarise(mse).se)},
+               {"coordinate_mse_count", mse.size()},
+               {"relative_error_geomean", number(geomean)},
+               {"relative_error_geomean_se", number(geomean * log.se)},
+               {"relative_error_geomean_count", logs.size()},
                {"valid_prediction_threshold", options.threshold},
                {"valid_prediction_censored", censored},
                {"n_held_out", held_out.size()},

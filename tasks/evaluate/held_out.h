@@ -37,9 +37,11 @@ struct HeldOutOptions {
 struct HeldOutEvaluation {
   std::vector<HeldOutRollout> rollouts;
   /// coordinate_mse (file units, over every time and coordinate), valid_prediction_time (file
-  /// time, mean over stretches), learned_h_drift (max |H(t) - H(0)| per stretch, mean, file
-  /// units) and learned_h_drift_relative (that over the spread of H on the training states),
-  /// each with a standard error over stretches when there are several; with a known H,
+  /// time, mean over stretches), relative_error_geomean (the geometric mean of the relative
+  /// state error in the model's units after each start; its standard error by the delta
+  /// method), learned_h_drift (max |H(t) - H(0)| per stretch, mean, file units) and
+  /// learned_h_drift_relative (that over the spread of H on the training states), each with a
+  /// standard error over stretches when there are several and a count; with a known H,
   /// held_out_energy_mse: (H(measured) - H(predicted))^2 over every held-out point (the
   /// dissipative-HNN paper's energy MSE along the test trajectory).
   nlohmann::json metrics;

@@ -2,6 +2,7 @@
 // The shared evaluator: final losses with standard errors, and rollouts of the true and learned
 // fields from the same initial states for the energy metric and the charts.
 
+#include <cstdint>
 #include <functional>
 #include <optional>
 #include <string>
@@ -15,13 +16,28 @@ namespace hnn::tasks {
 
 using physics::Batch;
 
+/// The evaluation's rollouts per run unless a task's data cannot give that many distinct initial
+/// states (the HNN paper's Table 1 used 15), and the most a run may ask for.
+constexpr int kDefaultRollouts = 100;
+constexpr int kMaxRollouts = 1000;
+/// The floor's perturbation: Finzi et al.'s 1e-4 (N(0, 1e-4^2) per component of the start).
+constexpr double kFloorPerturbation = 1e-4;
+
 /// How rollouts for the energy metric are made.
 struct RolloutConfig {
-  int trajectories = 15;
+  int trajectories = kDefaultRollouts;
   double t_end = 20.0;
   int points = 100;
   double rtol = 1e-9;
   double atol = 1e-12;
+  /// The floor (Note [Perturbed truth]): each start moved by N(0, perturbation^2) per component,
+  /// times perturbation_scale[c] when given (a data file's units), drawn from `seed`. 0: none.
+  double perturbation = kFloorPerturbation;
+  std::vector<double> perturbation_scale{};
+  std::uint64_t seed = 0;
+  /// Times in (0, t_end] at which the short-horizon errors are reported (chaotic systems, where
+  /// errors over the whole span say little); they need not be on the grid of `points`.
+  std::vector<double> horizons{};
 };
 
 /// Mean squared error of the model's field over a whole split (all N points, all D components),
@@ -32,10 +48,25 @@ nn::MeanStderr loss_stats(const nn::DynamicsModel<double>& model, const Batch& x
 /// The same for any field (a model in other units, say).
 nn::MeanStderr loss_stats(const physics::VectorField& field, const Batch& x, const Batch& dxdt);
 
+// Note [Perturbed truth]: how close a perfect model could come. The true system integrated from
+// starts perturbed by 1e-4 drifts from the true rollout as the system amplifies the difference
+// (slowly for the oscillators, exponentially for chaotic three bodies), and the relative error
+// it reaches is the floor of the relative-error metrics (Finzi et al. 2020, their repository's
+// compare_rollouts: pert_eps 1e-4 times a standard normal per component, absolute, over the
+// same times as the model's rollout). Their code divides |x^ - x| by |x^ + x|; their paper, and
+// we, by |x^| + |x|, which keeps the error within [0, 1].
+
 /// Rollouts from n initial states at the same times. Row i of each matrix is trajectory i.
+/// Measured truth (follow_measured) may miss samples: those rows of `truth` are NaN, and every
+/// metric skips them.
 struct Rollouts {
   std::vector<double> t;
   std::vector<Eigen::MatrixXd> truth, pred;  // per trajectory: times x dim
+  std::vector<Eigen::MatrixXd> floor;        // the perturbed truth; empty without a true system
+  bool measured = false;                     // truth is measured data (follow_measured)
+  std::vector<double> horizons;              // RolloutConfig::horizons
+  /// Per trajectory: horizons x dim, the states at those times (floor_at empty as floor).
+  std::vector<Eigen::MatrixXd> truth_at, pred_at, floor_at;
   Eigen::MatrixXd true_energy, pred_energy;  // trajectories x times
   Eigen::MatrixXd learned_h;                 // the HNN's own H along its rollout (empty if none)
   std::vector<bool> failed;                  // the learned rollout blew up (excluded from MSEs)
@@ -53,13 +84,22 @@ struct LearnedField {
 LearnedField learned_field(const nn::DynamicsModel<double>& model);
 
 /// Integrates the true field and the model's field from each row of x0 with the adaptive
-/// Dormand-Prince 5(4) method at config.rtol. A learned rollout that blows up is recorded as
-/// failed (with the time reached), never padded or silently dropped.
+/// Dormand-Prince 5(4) method at config.rtol. A learned rollout that blows up or whose field
+/// throws is recorded as failed (with the time reached, or the error), never padded or silently
+/// dropped.
 Rollouts make_rollouts(const physics::System& truth, const nn::DynamicsModel<double>& model,
                        const Batch& x0, const RolloutConfig& config);
 /// The same for any learned field (a model in other units, say).
 Rollouts make_rollouts(const physics::System& truth, const LearnedField& learned, const Batch& x0,
                        const RolloutConfig& config);
+
+/// Rollouts along measured paths, for data without a true system: `measured[i]` holds the states
+/// at times linspace(0, config.t_end, config.points) after its first row (NaN rows where a
+/// sample is missing; the first row must be there), and the learned field is integrated from
+/// each first row. The horizons move to the nearest of those times (Rollouts::horizons says
+/// where). Energies are NaN and there is no floor.
+Rollouts follow_measured(const std::vector<Eigen::MatrixXd>& measured, const LearnedField& learned,
+                         const RolloutConfig& config);
 
 /// Energy MSE: mean over trajectories and times of (E(true) - E(model))^2, with a standard error
 /// from 5 interleaved splits of the trajectories (the reference's "bootstrap" of 5 splits).
@@ -71,21 +111,38 @@ nn::MeanStderr energy_mse(const Rollouts& rollouts);
 nn::MeanStderr energy_error_at_end(const Rollouts& rollouts, double scale);
 
 /// Mean over the learned rollouts that did not fail, their times and every state component of
-/// the squared state error (the dissipative-HNN paper's state MSE); NaN when all failed.
-double state_mse(const Rollouts& rollouts);
+/// the squared state error (the dissipative-HNN paper's state MSE), with the standard error of
+/// the per-trajectory means (sample std / sqrt(n)); NaN when all failed.
+nn::MeanStderr state_mse(const Rollouts& rollouts);
+
+/// |x^ - x| / (|x^| + |x|) of each row (time) of a predicted path against the true one.
+Eigen::VectorXd relative_state_error(const Eigen::MatrixXd& pred, const Eigen::MatrixXd& truth);
 
 /// The relative state error e(t) = |x^ - x| / (|x^| + |x|) of the learned rollouts against the
 /// true ones (Finzi et al. 2020): its geometric mean over every trajectory and time after the
 /// start, and the valid prediction time, the first time e passes `threshold` (mean over the
 /// trajectories; a trajectory that never passes it counts its whole span and is `censored`).
-/// |x^ - x| / (|x^| + |x|) of each row (time) of a predicted path against the true one.
-Eigen::VectorXd relative_state_error(const Eigen::MatrixXd& pred, const Eigen::MatrixXd& truth);
-
+/// Standard errors over trajectories: the valid time's is std / sqrt(n); the geometric mean's
+/// is geomean * (std of the per-trajectory mean log error) / sqrt(n), the delta method's.
 struct RelativeError {
-  double geomean = NAN, valid_time = NAN;
-  int censored = 0;
+  double geomean = NAN, geomean_se = NAN, valid_time = NAN, valid_time_se = NAN;
+  int censored = 0, count = 0;
 };
 RelativeError relative_error(const Rollouts& rollouts, double threshold = 0.1);
+
+/// relative_error of the perturbed truth against the truth over the same times: the floor of
+/// Note [Perturbed truth] (its geometric mean), and the valid prediction time of a model whose
+/// only error were that of its start. NaN with count 0 without a floor.
+RelativeError relative_error_floor(const Rollouts& rollouts, double threshold = 0.1);
+
+/// The errors at one of RolloutConfig::horizons, over the learned rollouts that did not fail:
+/// the state MSE (mean over trajectories and components, standard error over trajectories), the
+/// geometric mean of the relative state error and of the floor's (standard errors as above).
+struct HorizonError {
+  double t = NAN;
+  nn::MeanStderr state_mse, relative_error, floor;
+};
+std::vector<HorizonError> horizon_errors(const Rollouts& rollouts);
 
 /// Mean over trajectories of the coordinate MSE at each time (for the charts).
 Eigen::VectorXd coordinate_mse_over_time(const Rollouts& rollouts);

@@ -55,7 +55,11 @@ std::vector<BadOption> bad_train_options() {
        "real-pendulum)"},
       {{"train", "spring", "--settings", "{\"trials\": 20}"},
        "task 'spring' has no setting 'trials' (known: loss, horizon, integrator, dt, sample_dt, "
-       "t_end)"},
+       "t_end, rollouts, rollout_t_end)"},
+      {{"train", "two-body", "--settings", "{\"rollouts\": 0}"},
+       "two-body: rollouts must be an integer from 1 to 1000, got 0"},
+      {{"train", "spring", "--settings", "{\"rollout_t_end\": -2}"},
+       "spring: rollout_t_end must be a finite number > 0, got -2"},
       {{"train", "pixel-pendulum", "--settings", "[20]"},
        "--settings must be a JSON object like '{\"trials\": 20}', got '[20]'"},
       {{"train", "pixel-pendulum", "--settings", "{\"trials\": 1}"},
@@ -143,7 +147,7 @@ TEST(CliOptions, BadCommandsAndOtherSubcommandsGetOneLine) {
        "Could not convert: --no-reversibility = x"},
       {{"reproduce", "--tasks", "spring,nope", "--out", (dir / "results").string()},
        "unknown task 'nope' (known: spring, pendulum, real-pendulum, two-body, three-body, "
-       "pixel-pendulum, damped-spring, double-pendulum, data)"},
+       "pixel-pendulum, damped-spring, double-pendulum, real-double-pendulum, data)"},
       {{"reproduce", "--tasks", "data", "--out", (dir / "results").string()},
        "reproduce runs the paper's tasks (spring, pendulum, real-pendulum, two-body, three-body, "
        "pixel-pendulum); 'data' is not one of them: train it with hnn train data"},

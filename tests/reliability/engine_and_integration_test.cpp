@@ -76,9 +76,10 @@ TEST(Integrations, RolloutThatBlowsUpIsOneLineWithTheTime) {
 TEST(Integrations, StiffLearnedRolloutIsRecordedAsFailedWithTheTime) {
   const TempDir dir;
   const fs::path run = dir / "run";
-  const Result r = run_hnn({"train", "spring", "--model", "baseline", "--lr", "1e10", "--steps",
-                            "30", "--hidden", "8", "--quiet", "--out", run.string()},
-                           dir.path());
+  const Result r = run_hnn(
+      {"train", "spring", "--model", "baseline", "--lr", "1e10", "--steps", "30", "--hidden", "8",
+       "--settings", R"({"rollouts": 15})", "--quiet", "--out", run.string()},
+      dir.path());
   ASSERT_EQ(r.code, 0) << r.err;
   const nlohmann::json m = read_json(run / "metrics.json");
   ASSERT_FALSE(m["rollout_failures"].empty());

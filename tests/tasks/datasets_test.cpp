@@ -94,7 +94,7 @@ TEST(TaskRegistry, TrainingSettingsAreThePapers) {
     EXPECT_EQ(c.hidden, (std::vector<int>{200, 200})) << e.task;
     const RolloutConfig r = task->rollout_config();
     EXPECT_EQ(r.points, e.rollout_points) << e.task;
-    EXPECT_EQ(r.trajectories, 15) << e.task;
+    EXPECT_EQ(r.trajectories, kDefaultRollouts) << e.task;
     EXPECT_DOUBLE_EQ(r.t_end, 20.0) << e.task;
     EXPECT_LE(r.rtol, 1e-9) << e.task;
     for (const nn::ModelKind model : {nn::ModelKind::kBaseline, nn::ModelKind::kHnn}) {

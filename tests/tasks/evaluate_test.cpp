@@ -139,8 +139,8 @@ TEST(MakeRollouts, TrueRolloutsConserveEnergyOnEveryTask) {
     const std::unique_ptr<FieldTask> task = make_field_task(name);
     const Dataset d = task->build_dataset(0);
     std::mt19937_64 rng(1);
-    const Batch x0 = task->rollout_states(d, rng);
-    ASSERT_EQ(x0.rows(), 15) << name;
+    const Batch x0 = task->rollout_states(d, kDefaultRollouts, rng);
+    ASSERT_EQ(x0.rows(), kDefaultRollouts) << name;
     ASSERT_EQ(x0.cols(), task->truth().dim()) << name;
     // A zero field stays at x0: its energy is the true energy of x0 at every time.
     const FunctionModel still = zero_model(x0.cols());
@@ -162,12 +162,12 @@ TEST(MakeRollouts, OscillatorRolloutStatesArePushedAwayFromZero) {
   for (const char* name : {"spring", "pendulum"}) {
     const std::unique_ptr<FieldTask> task = make_field_task(name);
     std::mt19937_64 rng(7);
-    const Batch x0 = task->rollout_states(task->build_dataset(0), rng);
+    const Batch x0 = task->rollout_states(task->build_dataset(0), 15, rng);
     EXPECT_EQ(x0.rows(), 15);
     EXPECT_GE(x0.cwiseAbs().minCoeff(), 0.2) << name;
     EXPECT_LE(x0.cwiseAbs().maxCoeff(), 1.0) << name;
     std::mt19937_64 again(7);
-    EXPECT_EQ(task->rollout_states(task->build_dataset(0), again), x0) << name;
+    EXPECT_EQ(task->rollout_states(task->build_dataset(0), 15, again), x0) << name;
   }
 }
 
@@ -175,8 +175,8 @@ TEST(MakeRollouts, RealPendulumStartsFromMeasuredTestStates) {
   const std::unique_ptr<FieldTask> task = make_field_task("real-pendulum");
   const Dataset d = task->build_dataset(0);
   std::mt19937_64 rng(0);
-  const Batch x0 = task->rollout_states(d, rng);
-  ASSERT_EQ(x0.rows(), 15);
+  const Batch x0 = task->rollout_states(d, kDefaultRollouts, rng);
+  ASSERT_EQ(x0.rows(), kDefaultRollouts);
   for (Eigen::Index i = 0; i < x0.rows(); ++i) {
     bool found = false;
     for (Eigen::Index k = 0; k < d.test_x.rows() && !found; ++k)
@@ -188,7 +188,7 @@ TEST(MakeRollouts, RealPendulumStartsFromMeasuredTestStates) {
 TEST(MakeRollouts, HnnConservesItsOwnLearnedHamiltonian) {
   const std::unique_ptr<FieldTask> task = make_field_task("spring");
   std::mt19937_64 rng(2);
-  const Batch x0 = task->rollout_states(task->build_dataset(0), rng).topRows(3);
+  const Batch x0 = task->rollout_states(task->build_dataset(0), 3, rng);
   const RolloutConfig config{.trajectories = 3, .t_end = 10.0, .points = 21};
   const auto hnn = small_model("hnn", 2, 5);
   const Rollouts r = make_rollouts(task->truth(), *hnn, x0, config);

@@ -128,6 +128,16 @@ TEST_P(RunFolder, HoldsCompleteMetricsCurvesRolloutsAndLoadableParameters) {
   EXPECT_EQ(m["n_test"].get<long>(), shape.n_test);
   EXPECT_EQ(m["hidden"], "16-16");
   EXPECT_EQ(m["n_rollouts"].get<int>() + int(m["rollout_failures"].size()), 15);
+  EXPECT_EQ(m["rollouts"], 15);
+  // Every rollout metric has a standard error and a count; the floor is below the model's.
+  for (const char* key : {"energy_mse", "state_mse", "relative_error_geomean",
+                          "relative_error_floor", "valid_prediction_time"}) {
+    EXPECT_TRUE(m.contains(std::string(key) + "_se")) << key;
+    EXPECT_EQ(m[std::string(key) + "_count"], m["n_rollouts"]) << key;
+  }
+  EXPECT_LT(m["relative_error_floor"].get<double>(), m["relative_error_geomean"].get<double>());
+  // Three bodies: the errors at early times, where chaos has not yet taken over.
+  EXPECT_EQ(m.contains("state_mse_t1"), shape.task == "three-body");
   expect_loss_curve(dir / "loss_curve.csv", 10);
   expect_rollout_csv(dir / "rollout.csv", shape, /*has_h=*/true);
 
@@ -316,6 +326,14 @@ TEST(Table1Markdown, OneRowOfOursAndOneOfThePapersPerTask) {
   EXPECT_NE(md.find("1.7000e-01 / n/a"), std::string::npos) << md;  // no standard error
   EXPECT_NE(md.find("| | *paper* | 3.7134e-02 ± 1.9e-03"), std::string::npos) << md;
   EXPECT_NE(md.find("61.5 s"), std::string::npos) << md;
+  // With the rollouts' count in the rows, the table states it beside the paper's 15.
+  json counted = hnn;
+  counted["rollouts"] = 100;
+  const std::string with_count = table1_markdown(json::array({base, counted}), 61.5);
+  EXPECT_NE(with_count.find("| spring | ours (2000 steps, double, 100 rollouts) |"),
+            std::string::npos)
+      << with_count;
+  EXPECT_NE(with_count.find("| | *paper* (15 rollouts) |"), std::string::npos) << with_count;
 }
 
 }  // namespace

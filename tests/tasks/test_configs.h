@@ -53,11 +53,13 @@ inline const std::vector<std::string>& state_tasks() {
   return names;
 }
 
-/// Tiny settings: narrow network, few steps, quiet. Minibatch tasks keep their batch size.
+/// Tiny settings: narrow network, few steps, quiet, 15 rollouts (the paper's count; the default
+/// is 100). Minibatch tasks keep their batch size.
 inline RunOptions small_run(const std::string& task, const std::string& model,
                             const std::filesystem::path& out, int steps = 10) {
   RunOptions o;
   o.task = task;
+  if (task != "pixel-pendulum") o.task_settings = {{"rollouts", 15}};
   o.model = parse_model(model);
   o.steps = steps;
   o.hidden = std::vector<int>{16, 16};

@@ -67,7 +67,7 @@ class ShortSpringTraining : public ::testing::Test {
     t.train = loss_stats(*t.model, data_->train_x, data_->train_dxdt);
     t.test = loss_stats(*t.model, data_->test_x, data_->test_dxdt);
     std::mt19937_64 rng(1);
-    const Batch x0 = task_->rollout_states(*data_, rng);
+    const Batch x0 = task_->rollout_states(*data_, 15, rng);
     t.energy = energy_mse(make_rollouts(task_->truth(), *t.model, x0, task_->rollout_config()));
     return t;
   }
