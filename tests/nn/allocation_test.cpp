@@ -57,7 +57,7 @@ long allocations_per_steps(nn::ModelKind kind, int threads, long rows, int warmu
                                   threads, rows, warmup, steps);
 }
 
-// The double-pendulum task's LNN, small: 4 inputs, angles wrapped, velocities scaled by 1/10.
+// The double-pendulum task's LNN, small: 4 inputs, angles as (cos, sin), velocities scaled by 1/10.
 nn::DynamicsConfig small_lnn(nn::Activation activation) {
   return {.model = nn::ModelKind::kLnn,
           .dim = 4,
