@@ -2,14 +2,17 @@
 // on row blocks of the batch, one per engine thread, through the GEMM of gemm.h. Values only:
 // when a backward must be recorded, ops_mlp.cpp calls mlp_recorded.cpp instead.
 //
-// Notation as in mlp_ops.h, with s_k = 1 - h_k^2 (tanh' at hidden layer k). The input gradient:
-//   a_{L-1} = W_L^T (every row),  d_k = a_k * s_k,  a_{k-1} = d_k W_k^T,  dy/dx = a_0.
-// Its backward, given G = dL/da_0, runs up the gradient chain and then down the forward chain:
+// Notation as in mlp_ops.h, with s_k = 1 - h_k^2 (tanh' at hidden layer k). The input gradient
+// of output j: a_{L-1} = W_L[:, j]^T (every row), d_k = a_k * s_k, a_{k-1} = d_k W_k^T,
+// dy_j/dx = a_0. Its backward, given G = dL/da_0, runs up the gradient chain of every output and
+// then down the forward chain once:
 //   abar_0 = G;  dbar_k = abar_{k-1} W_k;  dW_k += abar_{k-1}^T d_k;  abar_k = dbar_k * s_k;
-//   hbar_k = -2 h_k a_k dbar_k;  dW_L = colsum(abar_{L-1})^T;
+//   hbar_k += -2 h_k a_k dbar_k;  dW_L[:, j] = colsum(abar_{L-1})^T;
 //   then zbar_k = hbar_k * s_k (hbar_k plus zbar_{k+1} W_{k+1}^T from above), dW_k += h_{k-1}^T
 //   zbar_k, db_k = colsum(zbar_k), dx = zbar_1 W_1^T.
 // Six GEMMs of R x n x n per step for two hidden layers of width n: the minimum for this work.
+// Each further output adds three (the forward and the way down are shared: hbar is linear), where
+// one op per output would add six.
 
 #include <utility>
 
@@ -133,29 +136,36 @@ auto rows_of(const Node<T>& n, std::size_t i, RowBlock r) {
   return n.buffers[i].middleRows(r.begin, r.size());
 }
 
-// Up the gradient chain for rows r: dW_k = abar_{k-1}^T d_k, hbar_k, and dW_L (each dbar_k
-// becomes abar_k in place).
+// Up the gradient chain of output j for rows r: dW_k += abar_{k-1}^T d_k, hbar_k, and column j
+// of dW_L (each dbar_k becomes abar_k in place). Output 0 sets the sums, later outputs add.
 template <typename T>
-void up_the_gradient_chain(const MlpLayers<T>& l, const Node<T>& n, const Var<T>& g,
+void up_the_gradient_chain(const MlpLayers<T>& l, const Node<T>& n, const Var<T>& g, int j,
                            PartSpace<T>& w, RowBlock r) {
-  const GradientBuffers at{l.count()};
+  const GradientBuffers at{l.count(), l.outputs()};
+  const Index in = l.x().cols();
+  const T beta = j == 0 ? T(0) : T(1);
   Matrix<T>* abar = &w.grad[0];
-  *abar = g.value().middleRows(r.begin, r.size());
+  *abar = g.value().block(r.begin, j * in, r.size(), in);
   for (int k = 1; k < l.count(); ++k) {
     const auto hk = rows_of(n, at.h(k), r);
     Matrix<T>* dbar = &w.grad[std::size_t(k)];
     dbar->resize(abar->rows(), l.w(k).cols());
     gemm(*abar, false, l.w(k), false, *dbar);
-    w.dw[std::size_t(k)].resize(abar->cols(), l.w(k).cols());
-    gemm(*abar, true, rows_of(n, at.d(k), r), false, w.dw[std::size_t(k)]);
-    w.hbar[std::size_t(k)].resize(dbar->rows(), dbar->cols());
-    w.hbar[std::size_t(k)].array() =
-        T(-2) * hk.array() * rows_of(n, at.a(k), r).array() * dbar->array();
+    w.dw[std::size_t(k)].resize(abar->cols(), l.w(k).cols());  // kept by later outputs
+    gemm(*abar, true, rows_of(n, at.d(k, j), r), false, w.dw[std::size_t(k)], beta);
+    Matrix<T>& hbar = w.hbar[std::size_t(k)];
+    hbar.resize(dbar->rows(), dbar->cols());
+    const auto term = T(-2) * hk.array() * rows_of(n, at.a(k, j), r).array() * dbar->array();
+    if (j == 0) {
+      hbar.array() = term;
+    } else {
+      hbar.array() += term;
+    }
     dbar->array() *= T(1) - hk.array().square();
     abar = dbar;
   }
-  w.dw[std::size_t(l.count())].resize(abar->cols(), 1);
-  column_sums(*abar, w.dw[std::size_t(l.count())].col(0).transpose());
+  w.dw[std::size_t(l.count())].resize(abar->cols(), at.columns);
+  column_sums(*abar, w.dw[std::size_t(l.count())].col(j).transpose());
 }
 
 // Down the forward chain for rows r: zbar_k in place of hbar_k, dW_k += h_{k-1}^T zbar_k, db_k,
@@ -163,7 +173,7 @@ void up_the_gradient_chain(const MlpLayers<T>& l, const Node<T>& n, const Var<T>
 template <typename T>
 void down_the_forward_chain(const MlpLayers<T>& l, const Node<T>& n, PartSpace<T>& w, RowBlock r,
                             Matrix<T>* dx) {
-  const GradientBuffers at{l.count()};
+  const GradientBuffers at{l.count(), l.outputs()};
   Matrix<T>* hb = &w.hbar[std::size_t(l.count() - 1)];
   for (int k = l.count() - 1; k >= 1; --k) {
     hb->array() *= T(1) - rows_of(n, at.h(k), r).array().square();
@@ -181,22 +191,24 @@ void down_the_forward_chain(const MlpLayers<T>& l, const Node<T>& n, PartSpace<T
   }
 }
 
-// dy/dx for rows r, from the hidden layers already in the buffers: a_{L-1} = W_L^T, then
-// d_k = a_k s_k and a_{k-1} = d_k W_k^T down to a_0 = dy/dx.
+// dy_j/dx for rows r into the value's column block j, from the hidden layers already in the
+// buffers: a_{L-1} = W_L[:, j]^T, then d_k = a_k s_k and a_{k-1} = d_k W_k^T down to a_0.
 template <typename T>
-void input_gradient_rows(const MlpLayers<T>& l, Node<T>& node, RowBlock r) {
+void input_gradient_rows(const MlpLayers<T>& l, Node<T>& node, int j, RowBlock r) {
   const int L = l.count();
-  const GradientBuffers at{L};
+  const GradientBuffers at{L, l.outputs()};
+  const Index in = l.x().cols();
   const auto block = [&](std::size_t i) { return node.buffers[i].middleRows(r.begin, r.size()); };
-  auto out = node.value.middleRows(r.begin, r.size());
-  const auto top = l.w(L).col(0).transpose();  // dy/dh_{L-1}, the same for every row
+  auto out = node.value.block(r.begin, j * in, r.size(), in);
+  const auto top = l.w(L).col(j).transpose();  // dy_j/dh_{L-1}, the same for every row
   if (L == 1) return fill_rows(out, top);
-  fill_rows(block(at.a(L - 1)), top);
+  fill_rows(block(at.a(L - 1, j)), top);
   for (int k = L - 1; k >= 1; --k) {
-    block(at.d(k)).array() = block(at.a(k)).array() * (T(1) - block(at.h(k)).array().square());
-    const auto d = std::as_const(node.buffers[at.d(k)]).middleRows(r.begin, r.size());
+    block(at.d(k, j)).array() =
+        block(at.a(k, j)).array() * (T(1) - block(at.h(k)).array().square());
+    const auto d = std::as_const(node.buffers[at.d(k, j)]).middleRows(r.begin, r.size());
     if (k > 1) {
-      gemm(d, false, l.w(k), true, block(at.a(k - 1)));
+      gemm(d, false, l.w(k), true, block(at.a(k - 1, j)));
     } else {
       gemm(d, false, l.w(k), true, out);
     }
@@ -227,18 +239,21 @@ template <typename T>
 void input_gradient_forward(const MlpLayers<T>& l, Node<T>& node) {
   init_gemm();
   const int L = l.count();
-  const GradientBuffers at{L};
+  const GradientBuffers at{L, l.outputs()};
   const Index rows = l.x().rows();
   node.buffers.resize(at.size());
   for (int k = 1; k < L; ++k) {
-    for (std::size_t i : {at.h(k), at.a(k), at.d(k)}) node.buffers[i].resize(rows, l.w(k).cols());
+    node.buffers[at.h(k)].resize(rows, l.w(k).cols());
+    for (int j = 0; j < at.columns; ++j) {
+      for (std::size_t i : {at.a(k, j), at.d(k, j)}) node.buffers[i].resize(rows, l.w(k).cols());
+    }
   }
-  node.value.resize(rows, l.x().cols());
+  node.value.resize(rows, at.columns * l.x().cols());
   const int parts = parts_for(rows);
   parallel_for(parts, [&](int p) {
     const RowBlock r = row_block(rows, parts, p);
     hidden_rows(l, node.buffers, r);
-    input_gradient_rows(l, node, r);
+    for (int j = 0; j < at.columns; ++j) input_gradient_rows(l, node, j, r);
   });
 }
 
@@ -271,7 +286,7 @@ void input_gradient_backward_kernel(const Node<T>& n, const Var<T>& g, GradSink<
   parallel_for(parts, [&](int p) {
     const RowBlock r = row_block(rows, parts, p);
     PartSpace<T>& w = space[std::size_t(p)];
-    up_the_gradient_chain(l, n, g, w, r);
+    for (int j = 0; j < l.outputs(); ++j) up_the_gradient_chain(l, n, g, j, w, r);
     down_the_forward_chain(l, n, w, r, dx_node ? &dx_node->value : nullptr);
   });
   if (dx_node) s.add(0, Var<T>::of(*dx_node));

@@ -39,6 +39,8 @@ struct MlpLayers {
   const MlpLayout& layout;
 
   int count() const { return layout.layers; }
+  /// The MLP's outputs (the last weight's columns).
+  int outputs() const { return int(weight(count()).cols()); }
   int weight_input(int i) const { return i; }
   int bias_input(int i) const { return layout.bias_input[std::size_t(i - 1)]; }
   const Var<T>& x_var() const { return inputs[0]; }
@@ -57,14 +59,18 @@ MlpLayers<T> layers_of(const Node<T>& node) {
   return {node.inputs, node.template state_as<MlpLayout>()};
 }
 
-/// Where tanh_mlp_input_gradient keeps its intermediates in node.buffers: h_k, a_k and d_k for
-/// k = 1..L-1 (mlp_kernels.cpp defines a and d).
+/// Where tanh_mlp_input_gradient keeps its intermediates in node.buffers: h_k for k = 1..L-1,
+/// shared by the outputs, then a_k and d_k of every output column j (mlp_kernels.cpp defines a
+/// and d).
 struct GradientBuffers {
   int count;
+  int columns = 1;
   std::size_t h(int k) const { return std::size_t(k - 1); }
-  std::size_t a(int k) const { return std::size_t(count - 2 + k); }
-  std::size_t d(int k) const { return std::size_t(2 * count - 3 + k); }
-  std::size_t size() const { return std::size_t(3 * (count - 1)); }
+  std::size_t a(int k, int j = 0) const { return std::size_t((count - 1) * (1 + j) + k - 1); }
+  std::size_t d(int k, int j = 0) const {
+    return std::size_t((count - 1) * (1 + columns + j) + k - 1);
+  }
+  std::size_t size() const { return std::size_t((count - 1) * (1 + 2 * columns)); }
 };
 
 // ---- the hand-written kernels (mlp_kernels.cpp): values only, threaded over row blocks -------

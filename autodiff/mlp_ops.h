@@ -20,10 +20,12 @@ template <typename T>
 Var<T> tanh_mlp(const Var<T>& x, const std::vector<Var<T>>& weights,
                 const std::vector<Var<T>>& biases);
 
-/// The gradient of the MLP's single output with respect to its input, row by row: dy/dx, R x in
-/// (the HNN's dH/dx). Differentiable in x and every parameter (this is the second-order path of
-/// HNN training); the last bias does not affect it and is not an input. For one output of
-/// several, pass the column's slice of the last weight (slice_cols(w, column, 1)).
+/// The gradient of the MLP's output with respect to its input, row by row: dy/dx, R x in (the
+/// HNN's dH/dx). With m outputs, R x (m in): column block j is dy_j/dx (a D-HNN's dH/dx and
+/// dD/dx in one op, sharing the forward pass and half the backward). Differentiable in x and
+/// every parameter (this is the second-order path of HNN training); the last bias does not
+/// affect it and is not an input. For one output of several alone, pass the column's slice of
+/// the last weight (slice_cols(w, column, 1)).
 template <typename T>
 Var<T> tanh_mlp_input_gradient(const Var<T>& x, const std::vector<Var<T>>& weights,
                                const std::vector<Var<T>>& biases);

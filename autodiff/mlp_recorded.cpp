@@ -60,15 +60,17 @@ void add_if_wanted(GradSink<T>& s, int i, const auto& make_grad) {
   if (i >= 0 && s.wants(i)) s.add(i, make_grad());
 }
 
-// The input gradient's a_k and d_k (mlp_kernels.cpp), as ops: a_{L-1} = W_L^T on every row,
-// d_k = a_k s_k, a_{k-1} = d_k W_k^T.
+// The input gradient's a_k and d_k of output j (mlp_kernels.cpp), as ops: a_{L-1} = W_L[:, j]^T
+// on every row, d_k = a_k s_k, a_{k-1} = d_k W_k^T.
 template <typename T>
-void gradient_chain(const MlpLayers<T>& l, const std::vector<Var<T>>& h, Eigen::Index rows,
+void gradient_chain(const MlpLayers<T>& l, const std::vector<Var<T>>& h, Eigen::Index rows, int j,
                     std::vector<Var<T>>& a, std::vector<Var<T>>& d) {
   const int L = l.count();
   a.assign(std::size_t(L), Var<T>());
   d.assign(std::size_t(L), Var<T>());
-  a[std::size_t(L - 1)] = broadcast_to(transpose(l.weight(L)), rows, l.weight(L).rows());
+  const Var<T>& top = l.weight(L);
+  const Var<T> column = l.outputs() == 1 ? top : slice_cols(top, j, 1);
+  a[std::size_t(L - 1)] = broadcast_to(transpose(column), rows, top.rows());
   for (int k = L - 1; k >= 1; --k) {
     d[std::size_t(k)] = tanh_backward(a[std::size_t(k)], h[std::size_t(k)]);
     a[std::size_t(k - 1)] = matmul(d[std::size_t(k)], l.weight(k), false, true);
@@ -102,17 +104,25 @@ void input_gradient_backward_recorded(const MlpLayers<T>& l, const Var<T>& g, Gr
   std::vector<Var<T>>&h = scratch->h, &a = scratch->a, &d = scratch->d, &hbar = scratch->hbar;
   hidden_layers(l, h);
   hbar.assign(std::size_t(L), Var<T>());
-  gradient_chain(l, h, g.rows(), a, d);
-  Var<T> abar = g;  // up the gradient chain
-  for (int k = 1; k < L; ++k) {
-    const Var<T> dbar = matmul(abar, l.weight(k));
-    add_if_wanted(s, l.weight_input(k),
-                  [&] { return matmul(abar, d[std::size_t(k)], true, false); });
-    hbar[std::size_t(k)] = T(-2) * h[std::size_t(k)] * a[std::size_t(k)] * dbar;
-    abar = tanh_backward(dbar, h[std::size_t(k)]);
+  const int m = l.outputs();
+  const Eigen::Index in = l.x().cols();
+  for (int j = 0; j < m; ++j) {  // up the gradient chain of every output; the sink sums
+    gradient_chain(l, h, g.rows(), j, a, d);
+    Var<T> abar = m == 1 ? g : slice_cols(g, j * in, in);
+    for (int k = 1; k < L; ++k) {
+      const Var<T> dbar = matmul(abar, l.weight(k));
+      add_if_wanted(s, l.weight_input(k),
+                    [&] { return matmul(abar, d[std::size_t(k)], true, false); });
+      const Var<T> term = T(-2) * h[std::size_t(k)] * a[std::size_t(k)] * dbar;
+      hbar[std::size_t(k)] = j == 0 ? term : hbar[std::size_t(k)] + term;
+      abar = tanh_backward(dbar, h[std::size_t(k)]);
+    }
+    add_if_wanted(s, l.weight_input(L), [&] {
+      const Var<T> column = transpose(sum_rows(abar));
+      return m == 1 ? column : pad_cols(column, j, m);
+    });
   }
-  add_if_wanted(s, l.weight_input(L), [&] { return transpose(sum_rows(abar)); });
-  Var<T> hb = hbar[std::size_t(L - 1)];  // down the forward chain
+  Var<T> hb = hbar[std::size_t(L - 1)];  // down the forward chain (hbar is linear: once)
   for (int k = L - 1; k >= 1; --k) {
     const Var<T> zbar = tanh_backward(hb, h[std::size_t(k)]);
     add_if_wanted(s, l.weight_input(k),

@@ -93,10 +93,6 @@ template <typename T>
 Var<T> tanh_mlp_input_gradient(const Var<T>& x, const std::vector<Var<T>>& weights,
                                const std::vector<Var<T>>& biases) {
   check_layers("tanh_mlp_input_gradient", x, weights, biases, /*last_bias=*/false);
-  HNN_AD_CHECK(weights.back().cols() == 1,
-               "tanh_mlp_input_gradient: the MLP must have one output, its last weight is {} "
-               "(slice the column to differentiate: slice_cols(weight, column, 1))",
-               weights.back().shape());
   // The last bias does not affect dy/dx: it is not an input.
   return record_fused<T>("tanh_mlp_input_gradient", x, weights, biases, /*last_bias=*/false,
                          input_gradient_backward<T>, detail::input_gradient_forward<T>);

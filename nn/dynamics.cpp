@@ -180,11 +180,12 @@ ad::Var<T> tape_constant(Index rows, Index cols, const Fill& fill) {
   return ad::Var<T>::of(node);
 }
 
-// 1 / scale, one column per coordinate (1 x dim).
+// 1 / scale, one column per coordinate, `copies` times side by side (1 x copies * dim).
 template <typename T>
-ad::Var<T> inverse_scale(const std::vector<double>& scale) {
-  return tape_constant<T>(1, Index(scale.size()), [&](Matrix<T>& v) {
-    for (Index i = 0; i < v.cols(); ++i) v(0, i) = T(1.0 / scale[std::size_t(i)]);
+ad::Var<T> inverse_scale(const std::vector<double>& scale, Index copies = 1) {
+  const auto dim = Index(scale.size());
+  return tape_constant<T>(1, copies * dim, [&](Matrix<T>& v) {
+    for (Index i = 0; i < v.cols(); ++i) v(0, i) = T(1.0 / scale[std::size_t(i % dim)]);
   });
 }
 
@@ -223,6 +224,13 @@ ad::Var<T> DynamicsModel<T>::input_gradient(const ad::Var<T>& x, Index column) c
   }
   if (config_.input_scale.empty()) return g;
   return g * inverse_scale<T>(config_.input_scale);
+}
+
+template <typename T>
+ad::Var<T> DynamicsModel<T>::input_gradients(const ad::Var<T>& x) const {
+  const ad::Var<T> g = mlp_.input_gradients(mlp_input(x));
+  if (config_.input_scale.empty()) return g;
+  return g * inverse_scale<T>(config_.input_scale, mlp_.output_dim());
 }
 
 template class DynamicsModel<float>;

@@ -106,6 +106,8 @@ class DynamicsModel : public Module<T> {
   /// d mlp(mlp_input(x))[:, column] / dx: Mlp::input_gradient at the MLP's input, carried back
   /// through the (cos, sin) of the angles and the input scales (R x dim).
   ad::Var<T> input_gradient(const ad::Var<T>& x, Index column) const;
+  /// input_gradient of every MLP output side by side, R x (outputs * dim) (Mlp::input_gradients).
+  ad::Var<T> input_gradients(const ad::Var<T>& x) const;
 
   DynamicsConfig config_;
   Mlp<T> mlp_;

@@ -75,12 +75,20 @@ ad::Var<T> Hnn<T>::dissipation(const ad::Var<T>& x) const {
 
 // One formula for every field type: H is the MLP's column 0 and D its last column (1 for kBoth,
 // 0 for kConservative). In training, Mlp::input_gradient also gives the exact parameter
-// gradients of each part (through one fused op for a tanh MLP).
+// gradients of each part (through one fused op for a tanh MLP). kBoth takes both gradients from
+// one Mlp::input_gradients, which shares the work of the two (a D-HNN's training step).
 template <typename T>
 typename Hnn<T>::Parts Hnn<T>::time_derivative_parts(const ad::Var<T>& x) const {
   this->check_input("time_derivative", x.rows(), x.cols());
   const FieldType field = this->config_.field;
   Parts parts;
+  if (field == FieldType::kBoth) {
+    const Index dim = x.cols();
+    const ad::Var<T> both = this->input_gradients(x);  // [dH/dx | dD/dx]
+    parts.solenoidal = symplectic_gradient(ad::slice_cols(both, 0, dim));
+    parts.conservative = ad::slice_cols(both, dim, dim);
+    return parts;
+  }
   if (field != FieldType::kConservative) {
     parts.solenoidal = symplectic_gradient(this->input_gradient(x, 0));
   }

@@ -136,6 +136,19 @@ ad::Var<T> Mlp<T>::input_gradient(const ad::Var<T>& x, Index column) const {
 }
 
 template <typename T>
+ad::Var<T> Mlp<T>::input_gradients(const ad::Var<T>& x) const {
+  if (config_.activation == Activation::kTanh)
+    return ad::tanh_mlp_input_gradient(x, weights_, biases_);
+  if (output_dim() == 1) return generic_input_gradient(*this, x, 0);
+  thread_local std::vector<ad::Var<T>> columns;  // reused: no allocation per step
+  columns.clear();
+  for (Index j = 0; j < output_dim(); ++j) columns.push_back(generic_input_gradient(*this, x, j));
+  const ad::Var<T> all = ad::concat_cols(columns);
+  columns.clear();  // release the handles (capacity stays)
+  return all;
+}
+
+template <typename T>
 void Mlp<T>::visit_parameters(const ParameterVisitor<T>& visit) {
   for (std::size_t i = 0; i < layers_.size(); ++i) {
     visit_child<T>(layers_[i], fmt::format("layers.{}", i), visit);

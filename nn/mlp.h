@@ -42,6 +42,11 @@ class Mlp : public Module<T> {
   /// weight when there are several outputs); other activations run ad::grad with create_graph.
   /// Throws std::invalid_argument for a column outside [0, output_dim()).
   ad::Var<T> input_gradient(const ad::Var<T>& x, Index column = 0) const;
+  /// Every output's input gradient side by side: R x (out * in), column block j is
+  /// d y[:, j] / dx (a D-HNN's dH/dx and dD/dx). A tanh MLP runs them as one fused op, which
+  /// shares the forward pass and the way down of the backward between the outputs; other
+  /// activations take input_gradient of each column.
+  ad::Var<T> input_gradients(const ad::Var<T>& x) const;
 
   const MlpConfig& config() const { return config_; }
   const std::vector<Linear<T>>& layers() const { return layers_; }

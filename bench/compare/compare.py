@@ -205,9 +205,36 @@ def time_cases(args, progs, cases, data, inits):
     return runs
 
 
-def loss_check(args, progs, data, out):
-    """Spring HNN, full 2000 steps, f32 and f64, each implementation once."""
-    if "spring" not in data:
+def peer_checks(cases):
+    """The float64 twins of the peers' cases timed: their runs check the same computation."""
+    return [c.replace("-f32", "-f64") for c in cases if c in PEERS and c.endswith("-f32")]
+
+
+def peer_loss_check(args, progs, data, inits, cases):
+    """Each peer case in float64 from hnn's initial parameters, its timing steps, every
+    implementation once: the final losses agree to rounding (Note [Same computation])."""
+    env = tuned_env(args, args.loss_threads)
+    checks = []
+    for case in peer_checks(cases):
+        steps = max(20, int(CASES[case][3] * args.steps_scale))
+        for impl in (i for i in IMPLS if i in progs and i != "libtorch"):
+            cmd = command(impl, progs, args, case, data[CASES[case][0]], inits[case],
+                          args.loss_threads, steps)
+            try:
+                r = run_json(cmd, env, timeout=args.timeout * 5)
+            except (RuntimeError, subprocess.TimeoutExpired) as error:
+                log(f"  loss check {impl} {case}: {error}")
+                continue
+            log(f"  loss check {impl:9s} {case}: train {r['train_loss']!r} test {r['test_loss']!r}")
+            r.update(case=case)
+            checks.append(r)
+    return checks
+
+
+def loss_check(args, progs, data, out, cases):
+    """Spring HNN, full 2000 steps, f32 and f64, each implementation once (when a spring HNN
+    case is timed)."""
+    if "spring" not in data or not {"spring-hnn-f32", "spring-hnn-f64"} & set(cases):
         return []
     env = tuned_env(args, args.loss_threads)
     checks = []
@@ -256,7 +283,25 @@ def fmt_ms(row, impl):
     return f"{row[impl]['ms']:.3f}" if impl in row else "-"
 
 
-def markdown(meta, rows, checks):
+def peer_markdown(checks):
+    """The peers' float64 losses side by side, with their relative difference."""
+    lines = ["", "Same computation: the peers' cases in float64 from hnn's initial parameters "
+             "(train and test loss after the timing steps, 1 thread):", "",
+             "| case | steps | train loss hnn | train loss PyTorch | test loss hnn | "
+             "test loss PyTorch | largest relative difference |", "| --- | --- | --- | --- | --- | --- | --- |"]
+    for case in dict.fromkeys(c["case"] for c in checks):
+        by = {c["impl"]: c for c in checks if c["case"] == case}
+        if "hnn" not in by or "pytorch" not in by:
+            continue
+        h, t = by["hnn"], by["pytorch"]
+        rel = max(abs(h[k] - t[k]) / max(abs(h[k]), abs(t[k]), 1e-300)
+                  for k in ("train_loss", "test_loss"))
+        lines.append(f"| {case} | {h['steps']} | {h['train_loss']:.15g} | {t['train_loss']:.15g} "
+                     f"| {h['test_loss']:.15g} | {t['test_loss']:.15g} | {rel:.1e} |")
+    return lines
+
+
+def markdown(meta, rows, checks, peer_checks_run=()):
     lines = [f"Measured {meta['date']} on {meta['cpu']} ({meta['cpus']} CPUs), hnn {meta['commit']};"
              f" load average {meta['load_start']:.1f} at the start, {meta['load_end']:.1f} at the end;"
              f" {meta['rounds']} rounds, medians; env: {meta['env']}.", "",
@@ -277,6 +322,8 @@ def markdown(meta, rows, checks):
         for c in checks:
             lines.append(f"| {c['impl']} | {c['dtype']} | {c['train_loss']:.6g} | "
                          f"{c['test_loss']:.6g} |")
+    if peer_checks_run:
+        lines += peer_markdown(peer_checks_run)
     return "\n".join(lines) + "\n"
 
 
@@ -344,16 +391,19 @@ def main():
         return 0
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    data, inits = prepare(args, hnn, cases, out)
+    checked = [] if args.no_loss_check else peer_checks(cases)
+    data, inits = prepare(args, hnn, cases + [c for c in checked if c not in cases], out)
     started = time.time()
     runs = time_cases(args, progs, cases, data, inits)
-    checks = [] if args.no_loss_check else loss_check(args, progs, data, out)
+    checks = [] if args.no_loss_check else loss_check(args, progs, data, out, cases)
+    peers_checked = [] if args.no_loss_check else peer_loss_check(args, progs, data, inits, cases)
     meta.update(load_end=os.getloadavg()[0], minutes=(time.time() - started) / 60,
                 impls=[i for i in IMPLS if i in progs])
     rows = summarise(runs, cases, args.threads)
-    report = markdown(meta, rows, checks)
+    report = markdown(meta, rows, checks, peers_checked)
     stamp = datetime.datetime.now().strftime("%Y%m%d-%H%M%S")
-    result = {"meta": meta, "summary": rows, "loss_check": checks, "runs": runs}
+    result = {"meta": meta, "summary": rows, "loss_check": checks,
+              "peer_loss_check": peers_checked, "runs": runs}
     for name in (f"compare-{stamp}", "latest"):
         (out / f"{name}.json").write_text(json.dumps(result, indent=1) + "\n")
         (out / f"{name}.md").write_text(report)

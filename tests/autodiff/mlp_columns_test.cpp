@@ -1,7 +1,8 @@
 // The fused input gradient of one output column of a multi-output tanh MLP (the fused op on the
-// column's slice of the last weight, as nn::Mlp::input_gradient runs it) against double
-// backpropagation through the generic network: values, first and second derivatives, in float
-// and double, and finite differences.
+// column's slice of the last weight, as nn::Mlp::input_gradient runs it), and of every column in
+// one op (nn::Mlp::input_gradients, a D-HNN's H and D), against double backpropagation through
+// the generic network: values, first and second derivatives, in float and double, and finite
+// differences.
 
 #include <gtest/gtest.h>
 
@@ -29,9 +30,11 @@ namespace {
 const std::vector<Layout> kMultiOutput = {
     {{3, 5, 4, 2}, true}, {{2, 6, 3}, false}, {{2, 8, 8, 2}, false}, {{3, 2}, true}};
 
-// A column's input gradient, its first derivatives in every input (for a random upstream
-// gradient) and its second derivatives (the derivative of <first, v> for a random v), fused or
-// generic.
+constexpr Eigen::Index kAllColumns = -1;
+
+// A column's input gradient (kAllColumns: every column's, side by side, in one fused op), its
+// first derivatives in every input (for a random upstream gradient) and its second derivatives
+// (the derivative of <first, v> for a random v), fused or generic.
 template <typename T>
 std::vector<ad::Matrix<T>> derivatives(const Layout& l, Eigen::Index column, bool fused) {
   const std::vector<MatrixD> in = inputs_of(random_matrix(150, l.widths[0], 21), parameters(l, 22));
@@ -39,9 +42,15 @@ std::vector<ad::Matrix<T>> derivatives(const Layout& l, Eigen::Index column, boo
   std::vector<Var<T>> vars;
   for (const MatrixD& m : in) vars.push_back(Var<T>::leaf(m.cast<T>()));
   const Net<T> net = net_of(vars, l);
-  const Var<T> dy = fused ? column_input_gradient(vars[0], net, column)
-                          : generic_column_input_gradient(vars[0], net, column);
-  const Var<T> g = Var<T>::constant(random_matrix(150, l.widths[0], 23).cast<T>());
+  Var<T> dy;
+  if (column == kAllColumns) {
+    dy = fused ? ad::tanh_mlp_input_gradient(vars[0], net.weights, net.biases)
+               : ad::testing::generic_input_gradients(vars[0], net);
+  } else {
+    dy = fused ? column_input_gradient(vars[0], net, column)
+               : generic_column_input_gradient(vars[0], net, column);
+  }
+  const Var<T> g = Var<T>::constant(random_matrix(150, dy.cols(), 23).template cast<T>());
   const ad::GradOptions recorded{.create_graph = true, .allow_unused = true};
   const std::vector<Var<T>> first = ad::grad<T>({dy}, vars, recorded, {g});
   Var<T> projection = ad::sum(first[0] * first[0]);
@@ -71,7 +80,7 @@ class FusedColumn : public ::testing::TestWithParam<Layout> {};
 
 TEST_P(FusedColumn, MatchesDoubleBackpropagationToSecondOrderInFloatAndDouble) {
   const Layout l = GetParam();
-  for (Eigen::Index column = 0; column < l.widths.back(); ++column) {
+  for (Eigen::Index column = kAllColumns; column < l.widths.back(); ++column) {
     const auto reference = derivatives<double>(l, column, false);
     EXPECT_LT(relative_difference(derivatives<double>(l, column, true), reference), 1e-12)
         << "double, column " << column;
@@ -87,11 +96,13 @@ TEST_P(FusedColumn, PassesFirstAndSecondOrderGradientChecks) {
   // The last bias does not reach dy/dx: leave it out of the checked inputs.
   std::vector<MatrixD> used = in;
   if (l.last_bias) used.pop_back();
-  for (Eigen::Index column = 0; column < l.widths.back(); ++column) {
+  for (Eigen::Index column = kAllColumns; column < l.widths.back(); ++column) {
     const auto gradient = [&](const std::vector<VarD>& v) {
       std::vector<VarD> all = v;
       if (l.last_bias) all.push_back(VarD::leaf(in.back()));
-      return column_input_gradient(all[0], net_of(all, l), column);
+      const Net<double> net = net_of(all, l);
+      return column == kAllColumns ? ad::tanh_mlp_input_gradient(all[0], net.weights, net.biases)
+                                   : column_input_gradient(all[0], net, column);
     };
     ad::CheckResult r = ad::gradcheck(gradient, used);
     EXPECT_TRUE(r.ok) << "column " << column << ": " << r.log;

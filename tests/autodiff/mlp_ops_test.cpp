@@ -51,18 +51,18 @@ TEST_P(FusedMlp, ValueAndFirstDerivativesMatchTheGenericNetwork) {
   }
 }
 
+// Several outputs: every dy_j/dx side by side (mlp_columns_test.cpp checks them further).
 TEST_P(FusedMlp, InputGradientAndItsDerivativesMatchDoubleBackpropagation) {
   const Layout l = GetParam();
-  if (l.widths.back() != 1)
-    GTEST_SKIP() << "one output per op; mlp_columns_test.cpp slices columns";
   const std::vector<MatrixD> in = inputs_of(random_matrix(150, l.widths[0], 4), parameters(l, 5));
   ad::TapeScope scope;
   std::vector<VarD> vars;
   for (const MatrixD& m : in) vars.push_back(VarD::leaf(m));
   const Net<double> net = net_of(vars, l);
-  const MatrixD g = random_matrix(150, l.widths[0], 6);
+  const MatrixD g = random_matrix(150, l.widths[0] * l.widths.back(), 6);
   const VarD fused = ad::tanh_mlp_input_gradient(vars[0], net.weights, net.biases);
-  const VarD generic = generic_input_gradient(vars[0], net);
+  const VarD generic = l.widths.back() == 1 ? generic_input_gradient(vars[0], net)
+                                            : ad::testing::generic_input_gradients(vars[0], net);
   EXPECT_LT((fused.value() - generic.value()).cwiseAbs().maxCoeff(), 1e-13);
   const ad::GradOptions unused{.allow_unused = true};
   const auto gf = ad::grad<double>({fused}, vars, unused, {VarD::constant(g)});
@@ -83,7 +83,6 @@ TEST_P(FusedMlp, PassesFirstAndSecondOrderGradientChecks) {
   EXPECT_TRUE(r.ok) << r.log;
   r = ad::gradgradcheck(forward, in);
   EXPECT_TRUE(r.ok) << r.log;
-  if (l.widths.back() != 1) return;
   const auto gradient = [&](const std::vector<VarD>& v) {
     const Net<double> net = net_of(v, l);
     return ad::tanh_mlp_input_gradient(v[0], net.weights, net.biases);
@@ -171,12 +170,8 @@ TEST(FusedMlpErrors, NameTheOpTheLayerAndTheShapes) {
         << e.what();
   }
   const VarD x2 = VarD::constant(MatrixD::Zero(4, 2));
-  try {
-    ad::tanh_mlp_input_gradient<double>(x2, {w1, w2}, {VarD(), VarD()});
-    FAIL() << "no error for a two-output MLP";
-  } catch (const ad::Error& e) {
-    EXPECT_NE(std::string(e.what()).find("one output"), std::string::npos) << e.what();
-  }
+  // Two outputs: both input gradients side by side, 4 x (2 * 2).
+  EXPECT_EQ(ad::tanh_mlp_input_gradient<double>(x2, {w1, w2}, {VarD(), VarD()}).shape(), "4x4");
   EXPECT_THROW(ad::tanh_mlp<double>(x2, {w1}, {}), ad::Error);
 }
 

@@ -91,4 +91,14 @@ Var<T> generic_column_input_gradient(const Var<T>& x, const Net<T>& net, Eigen::
   return ad::grad<T>({ad::sum(y)}, {x}, {.create_graph = true})[0];
 }
 
+// Every output's dy_j/dx side by side (what the fused op gives for several outputs), through the
+// generic double backpropagation.
+template <typename T>
+Var<T> generic_input_gradients(const Var<T>& x, const Net<T>& net) {
+  std::vector<Var<T>> columns;
+  for (Eigen::Index j = 0; j < net.weights.back().cols(); ++j)
+    columns.push_back(generic_column_input_gradient(x, net, j));
+  return ad::concat_cols(columns);
+}
+
 }  // namespace hnn::ad::testing
