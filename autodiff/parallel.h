@@ -27,8 +27,10 @@ class PartFn {
   void (*call_)(void*, int);
 };
 
-/// Calls part(i) for i in [0, parts) concurrently (the caller runs part 0) and returns when all
-/// have finished; the first exception thrown by a part is rethrown here. Nested calls, and calls
+/// Calls part(i) for i in [0, parts) concurrently and returns when all have finished: the caller
+/// and the workers claim parts as they get to them, so a worker the scheduler has not woken yet
+/// delays nothing (Note [Claimed parts] in parallel.cpp). The first exception thrown by a part
+/// (lowest i) is rethrown here. Nested calls, and calls
 /// while another thread's job holds the workers, run the same parts serially: the split (and so
 /// every result, bit for bit) depends only on `parts`.
 void parallel_for(int parts, PartFn part);
