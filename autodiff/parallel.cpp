@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cstdint>
 #include <exception>
 #include <memory>
@@ -64,6 +65,7 @@ class Pool {
   static constexpr std::uint64_t kGeneration = std::uint64_t(1) << 32;
   static constexpr int kPartsShift = 16;
   static constexpr std::uint64_t kField = 0xFFFF;
+  static constexpr std::chrono::microseconds kSpin{50};  // Note [Brief spin]
 
   static void serial(int parts, PartFn part) {
     for (int i = 0; i < parts; ++i) part(i);
@@ -104,8 +106,30 @@ class Pool {
       Claimed c = claim();
       for (; c.part >= 0; c = claim()) run_part(c.part, c.parts);
       if (stop_.load()) return;  // after the claim: a word seen after ~Pool's change means stop
-      claim_.wait(c.word);       // until a new job (or ~Pool) changes the word
+      if (!spin_until_changed(c.word)) claim_.wait(c.word);  // until a new job or ~Pool
     }
+  }
+
+  // Note [Brief spin]: a training step hands the workers a job per op, often tens of
+  // microseconds apart; a worker that goes to sleep in between is woken by a system call and
+  // arrives late (tens of microseconds on a VM), by which time the caller has claimed its part.
+  // So it watches the claim word for kSpin first (pausing, not yielding) and sleeps only after.
+  // Bounded, so an idle pool burns no core.
+  bool spin_until_changed(std::uint64_t word) const {
+    const auto until = std::chrono::steady_clock::now() + kSpin;
+    while (true) {
+      for (int i = 0; i < 64; ++i) {
+        if (claim_.load(std::memory_order_relaxed) != word) return true;
+        pause();
+      }
+      if (std::chrono::steady_clock::now() > until) return false;
+    }
+  }
+
+  static void pause() {
+#if defined(__x86_64__) || defined(__i386__)
+    __builtin_ia32_pause();
+#endif
   }
 
   std::vector<std::thread> workers_;

@@ -1,7 +1,8 @@
 #pragma once
-// The engine's worker threads: fused kernels split a batch into row blocks, one per thread.
-// Workers are created once and sleep between jobs (futex waits, no spinning that would steal a
-// shared machine's cores), so a training step costs two wake-ups, not thread creation.
+// The engine's worker threads: fused kernels and big ops split a batch into row blocks, one per
+// thread. Workers are created once; between jobs they watch for the next one for 50 us, then
+// sleep (futex waits), so jobs in quick succession cost no wake-up and an idle pool steals no
+// shared machine's cores (Note [Brief spin] in parallel.cpp).
 
 #include <Eigen/Core>
 #include <type_traits>
