@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
+#include <cstdint>
 #include <exception>
 #include <memory>
 #include <mutex>
@@ -16,19 +18,23 @@ namespace {
 
 thread_local bool g_inside_part = false;
 
-// Workers 1..n-1 wait for the job generation to change, run their part (if the job has one
-// for them), and count down `pending_`: every worker answers every job, so none can miss one
-// or see one twice. One job at a time: a caller that finds the pool busy runs its parts itself, in
-// the same blocks, so results never depend on who got the pool.
+// Note [Claimed parts]: a job's parts are claimed one at a time from one atomic word, by the
+// caller and by every worker that wakes while parts are left; the caller, once nothing is left
+// to claim, waits only for the parts that workers claimed and are running. A worker that the
+// scheduler has not woken yet (a shared, loaded machine) therefore costs nothing: waiting for
+// every worker to answer every job stalled each op for a time slice there, making two threads
+// several times slower than one. Part i computes block i whoever runs it, so results never
+// depend on who claimed what. One job at a time: a caller that finds the pool busy runs its
+// parts itself.
 class Pool {
  public:
   explicit Pool(int threads) : errors_(std::size_t(threads)) {
-    for (int i = 1; i < threads; ++i) workers_.emplace_back([this, i] { work(i); });
+    for (int i = 1; i < threads; ++i) workers_.emplace_back([this] { work(); });
   }
   ~Pool() {
     stop_.store(true);
-    generation_.fetch_add(1);
-    generation_.notify_all();
+    claim_.fetch_add(kGeneration);  // a change every waiting worker sees
+    claim_.notify_all();
     for (std::thread& t : workers_) t.join();
   }
   int threads() const { return int(workers_.size()) + 1; }
@@ -37,24 +43,52 @@ class Pool {
     std::unique_lock lock(busy_, std::try_to_lock);
     if (!lock.owns_lock() || parts > threads()) return serial(parts, part);
     job_ = &part;
-    parts_ = parts;
     std::fill(errors_.begin(), errors_.end(), nullptr);
-    pending_.store(threads() - 1);
-    generation_.fetch_add(1);
-    generation_.notify_all();
-    run_part(0);
-    for (int left = pending_.load(); left != 0; left = pending_.load()) pending_.wait(left);
+    done_.store(0, std::memory_order_relaxed);
+    generation_ += kGeneration;
+    // Publishes the job (release: job_ and the reset counters are visible to whoever claims).
+    claim_.store(generation_ | std::uint64_t(parts) << kPartsShift, std::memory_order_release);
+    claim_.notify_all();
+    for (int i = claim().part; i >= 0; i = claim().part) run_part(i, parts);
+    for (int d = done_.load(std::memory_order_acquire); d != parts;
+         d = done_.load(std::memory_order_acquire)) {
+      done_.wait(d);
+    }
     for (const std::exception_ptr& e : errors_) {
       if (e) std::rethrow_exception(e);
     }
   }
 
  private:
+  // The claim word: generation (bits 32..63, one step per job), the job's parts (16..31) and the
+  // next unclaimed part (0..15).
+  static constexpr std::uint64_t kGeneration = std::uint64_t(1) << 32;
+  static constexpr int kPartsShift = 16;
+  static constexpr std::uint64_t kField = 0xFFFF;
+  static constexpr std::chrono::microseconds kSpin{50};  // Note [Brief spin]
+
   static void serial(int parts, PartFn part) {
     for (int i = 0; i < parts; ++i) part(i);
   }
 
-  void run_part(int i) {
+  struct Claimed {
+    int part = -1;           // -1: every part of the current job is claimed
+    int parts = 0;           // of the job the part belongs to
+    std::uint64_t word = 0;  // the claim word this saw last
+  };
+
+  // The next part of the current job.
+  Claimed claim() {
+    std::uint64_t word = claim_.load(std::memory_order_acquire);
+    while ((word & kField) < ((word >> kPartsShift) & kField)) {
+      if (claim_.compare_exchange_weak(word, word + 1, std::memory_order_acq_rel)) {
+        return {int(word & kField), int((word >> kPartsShift) & kField), word};
+      }
+    }
+    return {.word = word};
+  }
+
+  void run_part(int i, int parts) {
     g_inside_part = true;
     try {
       (*job_)(i);
@@ -62,27 +96,50 @@ class Pool {
       errors_[std::size_t(i)] = std::current_exception();
     }
     g_inside_part = false;
+    if (done_.fetch_add(1, std::memory_order_acq_rel) + 1 == parts) done_.notify_one();
   }
 
-  void work(int i) {
-    std::uint64_t seen = 0;
+  void work() {
     while (true) {
-      generation_.wait(seen);
-      seen = generation_.load();
-      if (stop_.load()) return;
-      if (i < parts_) run_part(i);
-      if (pending_.fetch_sub(1) == 1) pending_.notify_one();
+      // Claiming orders this after the job's publication, so job_ is the claimed part's job
+      // (whose caller cannot publish another before this part is done).
+      Claimed c = claim();
+      for (; c.part >= 0; c = claim()) run_part(c.part, c.parts);
+      if (stop_.load()) return;  // after the claim: a word seen after ~Pool's change means stop
+      if (!spin_until_changed(c.word)) claim_.wait(c.word);  // until a new job or ~Pool
     }
   }
 
+  // Note [Brief spin]: a training step hands the workers a job per op, often tens of
+  // microseconds apart; a worker that goes to sleep in between is woken by a system call and
+  // arrives late (tens of microseconds on a VM), by which time the caller has claimed its part.
+  // So it watches the claim word for kSpin first (pausing, not yielding) and sleeps only after.
+  // Bounded, so an idle pool burns no core.
+  bool spin_until_changed(std::uint64_t word) const {
+    const auto until = std::chrono::steady_clock::now() + kSpin;
+    while (true) {
+      for (int i = 0; i < 64; ++i) {
+        if (claim_.load(std::memory_order_relaxed) != word) return true;
+        pause();
+      }
+      if (std::chrono::steady_clock::now() > until) return false;
+    }
+  }
+
+  static void pause() {
+#if defined(__x86_64__) || defined(__i386__)
+    __builtin_ia32_pause();
+#endif
+  }
+
   std::vector<std::thread> workers_;
-  std::vector<std::exception_ptr> errors_;
+  std::vector<std::exception_ptr> errors_;  // per part
   std::mutex busy_;
-  std::atomic<std::uint64_t> generation_{0};
-  std::atomic<int> pending_{0};
+  std::atomic<std::uint64_t> claim_{0};
+  std::atomic<int> done_{0};
   std::atomic<bool> stop_{false};
+  std::uint64_t generation_ = 0;  // the caller's copy (under busy_)
   const PartFn* job_ = nullptr;
-  int parts_ = 0;
 };
 
 int default_threads() {

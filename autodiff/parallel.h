@@ -1,7 +1,8 @@
 #pragma once
-// The engine's worker threads: fused kernels split a batch into row blocks, one per thread.
-// Workers are created once and sleep between jobs (futex waits, no spinning that would steal a
-// shared machine's cores), so a training step costs two wake-ups, not thread creation.
+// The engine's worker threads: fused kernels and big ops split a batch into row blocks, one per
+// thread. Workers are created once; between jobs they watch for the next one for 50 us, then
+// sleep (futex waits), so jobs in quick succession cost no wake-up and an idle pool steals no
+// shared machine's cores (Note [Brief spin] in parallel.cpp).
 
 #include <Eigen/Core>
 #include <type_traits>
@@ -27,8 +28,10 @@ class PartFn {
   void (*call_)(void*, int);
 };
 
-/// Calls part(i) for i in [0, parts) concurrently (the caller runs part 0) and returns when all
-/// have finished; the first exception thrown by a part is rethrown here. Nested calls, and calls
+/// Calls part(i) for i in [0, parts) concurrently and returns when all have finished: the caller
+/// and the workers claim parts as they get to them, so a worker the scheduler has not woken yet
+/// delays nothing (Note [Claimed parts] in parallel.cpp). The first exception thrown by a part
+/// (lowest i) is rethrown here. Nested calls, and calls
 /// while another thread's job holds the workers, run the same parts serially: the split (and so
 /// every result, bit for bit) depends only on `parts`.
 void parallel_for(int parts, PartFn part);

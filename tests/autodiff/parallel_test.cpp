@@ -1,0 +1,86 @@
+// The engine's worker pool (autodiff/parallel.h): every part of every job runs exactly once,
+// whoever claims it (Note [Claimed parts]), also with jobs from several threads at once and with
+// nested calls; the lowest failing part's exception reaches the caller; the pool survives a
+// change of thread count.
+
+#include "autodiff/parallel.h"
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <stdexcept>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace ad = hnn::ad;
+
+namespace {
+
+// A few microseconds of work, so that workers wake in time to claim parts too.
+void Busy() {
+  volatile int sink = 0;
+  for (int i = 0; i < 2000; ++i) sink = sink + i;
+}
+
+// Runs `jobs` jobs of 1..threads parts, counting each part's runs; returns the counts that are
+// not exactly one.
+int WrongCounts(int jobs, int threads) {
+  int wrong = 0;
+  std::vector<std::atomic<int>> runs(static_cast<std::size_t>(threads));
+  for (int job = 0; job < jobs; ++job) {
+    const int parts = 1 + job % threads;
+    for (int i = 0; i < parts; ++i) runs[std::size_t(i)].store(0);
+    ad::parallel_for(parts, [&](int i) {
+      Busy();
+      runs[std::size_t(i)].fetch_add(1);
+    });
+    for (int i = 0; i < parts; ++i) wrong += runs[std::size_t(i)].load() != 1;
+  }
+  return wrong;
+}
+
+TEST(ParallelFor, RunsEveryPartOfEveryJobExactlyOnce) {
+  for (int threads : {1, 2, 4}) {
+    ad::set_num_threads(threads);
+    EXPECT_EQ(WrongCounts(20000, threads), 0) << threads << " threads";
+  }
+  ad::set_num_threads(2);
+}
+
+TEST(ParallelFor, JobsFromSeveralThreadsAndNestedCallsRunEveryPartOnce) {
+  ad::set_num_threads(2);
+  std::atomic<int> wrong{0};
+  std::vector<std::thread> callers;
+  for (int t = 0; t < 3; ++t) {
+    callers.emplace_back([&] {
+      for (int job = 0; job < 3000; ++job) {
+        std::atomic<int> inner{0};
+        std::atomic<int> outer{0};
+        ad::parallel_for(2, [&](int) {
+          Busy();
+          outer.fetch_add(1);
+          ad::parallel_for(2, [&](int) { inner.fetch_add(1); });  // nested: serial
+        });
+        wrong += outer.load() != 2 || inner.load() != 4;
+      }
+    });
+  }
+  for (std::thread& c : callers) c.join();
+  EXPECT_EQ(wrong.load(), 0);
+}
+
+TEST(ParallelFor, RethrowsTheLowestFailingPartsException) {
+  ad::set_num_threads(2);
+  for (int job = 0; job < 200; ++job) {
+    try {
+      ad::parallel_for(2, [](int i) { throw std::runtime_error("part " + std::to_string(i)); });
+      FAIL() << "no exception";
+    } catch (const std::runtime_error& e) {
+      EXPECT_EQ(std::string(e.what()), "part 0");
+    }
+  }
+  EXPECT_EQ(WrongCounts(100, 2), 0) << "the pool works after failed jobs";
+}
+
+}  // namespace
