@@ -39,22 +39,54 @@ struct CompareOptions {
   std::string command;  // the command line, for the report
 };
 
-// Tasks x models x losses, crossed.
+// Tasks x models x losses, crossed; in the default study also the protocol of a peer: sweep keys
+// of every run (`keys`) and of the rollout-loss runs (`rollout_keys`), the headline metric and
+// further metrics.json keys for the table.
 struct Group {
   std::vector<std::string> tasks, models, losses;
+  ordered_json keys = ordered_json::object(), rollout_keys = ordered_json::object();
+  std::string headline;              // "": the peers file's for the task
+  std::vector<std::string> metrics;  // shown on every row of the group
 };
 
-// The default study: the tasks where each family matters. Names this hnn lacks (a family still
-// to come) become skipped rows saying so, not errors.
-std::vector<Group> default_study() {
-  return {{{"real-pendulum", "damped-spring"}, {"baseline", "hnn", "dhnn"}, {"derivative"}},
-          {{"double-pendulum"}, {"baseline", "hnn", "lnn"}, {"derivative"}},
-          {{"three-body", "spring"}, {"baseline", "hnn"}, {"derivative", "rollout"}}};
+Group crossed(std::vector<std::string> tasks, std::vector<std::string> models,
+              std::vector<std::string> losses) {
+  Group g;
+  g.tasks = std::move(tasks);
+  g.models = std::move(models);
+  g.losses = std::move(losses);
+  return g;
 }
 
-// One row of the table: a (task, model, loss) and its runs, or why it does not run.
+// The default study: the tasks where each family matters, each at its peer's protocol. Names this
+// hnn lacks become skipped rows saying so, not errors.
+std::vector<Group> default_study() {
+  // SRNN's three-body: the HNN paper's system sampled at dt = 1 (its 100 + 32 trajectories of 10
+  // points), trained through leapfrog on windows of 5 points, batch 32 (docs/families.md).
+  Group three_body = crossed({"three-body"}, {"baseline", "hnn"}, {"derivative", "rollout"});
+  three_body.keys["settings"] = {{"setup", "srnn"}};
+  three_body.rollout_keys = {
+      {"integrator", "leapfrog"}, {"horizon", 4}, {"batch", 32}, {"steps", 5000}};
+  three_body.headline = "stretch_position_error";
+  three_body.metrics = {"truth_leapfrog_position_error", "valid_prediction_time"};
+  // Where the rollout loss wins: the spring sampled every time unit, noisy (docs/families.md).
+  Group coarse_spring = crossed({"spring"}, {"baseline", "hnn"}, {"derivative", "rollout"});
+  coarse_spring.keys["settings"] = {{"sample_dt", 1.0}, {"t_end", 6}};
+  coarse_spring.rollout_keys = {{"integrator", "leapfrog"}, {"horizon", 1}};
+  coarse_spring.headline = "stretch_state_mse";
+  coarse_spring.metrics = {"truth_leapfrog_state_mse"};
+  return {crossed({"real-pendulum", "damped-spring"}, {"baseline", "hnn", "dhnn"}, {"derivative"}),
+          crossed({"double-pendulum"}, {"baseline", "hnn", "lnn"}, {"derivative"}), three_body,
+          coarse_spring};
+}
+
+// One row of the table: a (task, model, loss) at its protocol's keys, and its runs, or why it
+// does not run.
 struct Row {
   std::string task, model, loss;
+  ordered_json keys = ordered_json::object();
+  std::string headline;
+  std::vector<std::string> metrics;
   std::string skipped;  // "": runs
   std::vector<std::string> runs;
 };
@@ -77,8 +109,8 @@ void check_names(const std::vector<std::string>& given, const std::vector<std::s
 // and --loss given.
 std::vector<Group> study(const CompareOptions& o) {
   if (!o.tasks.empty()) {
-    return {{o.tasks, o.models.empty() ? tasks::model_names() : o.models,
-             o.losses.empty() ? std::vector<std::string>{"derivative"} : o.losses}};
+    return {crossed(o.tasks, o.models.empty() ? tasks::model_names() : o.models,
+                    o.losses.empty() ? std::vector<std::string>{"derivative"} : o.losses)};
   }
   std::vector<Group> groups;
   for (Group g : default_study()) {
@@ -103,7 +135,8 @@ ordered_json row_spec(const Row& row, const CompareOptions& o) {
   ordered_json seeds = ordered_json::array();
   for (int s = 0; s < o.seeds; ++s) seeds.push_back(static_cast<unsigned long long>(s));
   spec["seed"] = seeds;
-  if (o.steps > 0) spec["steps"] = {o.steps};
+  for (const auto& [key, value] : row.keys.items()) spec[key] = ordered_json::array({value});
+  if (o.steps > 0) spec["steps"] = {o.steps};               // over the protocol's own
   if (row.loss != "derivative") spec["loss"] = {row.loss};  // derivative: hnn train's default
   return spec;
 }
@@ -159,8 +192,12 @@ std::vector<Row> rows_of(const std::vector<Group>& groups) {
   for (const Group& g : groups)
     for (const std::string& t : g.tasks)
       for (const std::string& m : g.models)
-        for (const std::string& l : g.losses)
-          if (seen.insert(t + "\n" + m + "\n" + l).second) rows.push_back({t, m, l, "", {}});
+        for (const std::string& l : g.losses) {
+          if (!seen.insert(t + "\n" + m + "\n" + l).second) continue;
+          Row row{t, m, l, g.keys, g.headline, g.metrics, "", {}};
+          if (l == "rollout") row.keys.update(g.rollout_keys);
+          rows.push_back(std::move(row));
+        }
   return rows;
 }
 
@@ -202,6 +239,8 @@ json read_peers(const fs::path& file) {
     need("metric", !p.contains("metric") || p["metric"].is_null() || p["metric"].is_string(),
          "a metrics.json key or null");
     need("se", !p.contains("se") || p["se"].is_null() || p["se"].is_number(), "a number");
+    need("settings", !p.contains("settings") || p["settings"].is_object(),
+         "an object (the run settings of their protocol)");
   }
   return doc;
 }
@@ -217,7 +256,9 @@ json table1_peers(const std::vector<Row>& rows) {
   const std::vector<std::string> paper_tasks = tasks::paper_task_names();
   std::set<std::string> done;
   for (const Row& row : rows) {
-    if (!contains(paper_tasks, row.task) || !done.insert(row.task).second) continue;
+    // A row at other settings than the task's own (a peer's protocol) is not Table 1's.
+    if (!contains(paper_tasks, row.task) || !row.keys.empty() || !done.insert(row.task).second)
+      continue;
     const auto task = tasks::make_task(row.task);
     for (const nn::ModelKind model : {nn::ModelKind::kBaseline, nn::ModelKind::kHnn}) {
       const tasks::PaperRow paper = task->paper(model);
@@ -236,7 +277,8 @@ json table1_peers(const std::vector<Row>& rows) {
                        {"value", v.mean},
                        {"se", v.se},
                        {"n", "the paper's seeds"},
-                       {"protocol", kTable1Protocol}});
+                       {"protocol", kTable1Protocol},
+                       {"task_defaults_only", true}});
       }
     }
   }
@@ -249,6 +291,9 @@ json rows_json(const std::vector<Row>& rows) {
     out.push_back({{"task", r.task},
                    {"model", r.model},
                    {"loss", r.loss},
+                   {"keys", json::parse(r.keys.dump())},
+                   {"headline", r.headline.empty() ? json(nullptr) : json(r.headline)},
+                   {"metrics", r.metrics},
                    {"runs", r.runs},
                    {"skipped", r.skipped.empty() ? json(nullptr) : json(r.skipped)}});
   }
@@ -273,10 +318,11 @@ json compare_section(const std::vector<Row>& rows, const CompareOptions& o) {
 
 void list_rows(const std::vector<Row>& rows) {
   for (const Row& r : rows) {
+    const std::string keys = r.keys.empty() ? "" : " " + r.keys.dump();
     if (r.skipped.empty())
-      fmt::print("{} {} {}: {} runs\n", r.task, r.model, r.loss, r.runs.size());
+      fmt::print("{} {} {}{}: {} runs\n", r.task, r.model, r.loss, keys, r.runs.size());
     else
-      fmt::print("{} {} {}: skipped: {}\n", r.task, r.model, r.loss, r.skipped);
+      fmt::print("{} {} {}{}: skipped: {}\n", r.task, r.model, r.loss, keys, r.skipped);
   }
 }
 
@@ -288,6 +334,9 @@ void run_compare(CompareOptions o) {
   if (o.quick && o.steps == 0) o.steps = kQuickSteps;
   const fs::path out = fs::absolute(o.out).lexically_normal();
   std::vector<Row> rows = rows_of(study(o));
+  if (o.steps > 0) {
+    for (Row& row : rows) row.keys.erase("steps");  // --steps is every run's
+  }
   const sweep::SweepPlan plan = expand_rows(rows, o, out);
   const json section = compare_section(rows, o);  // the peers file is checked before any run
   if (o.list) {

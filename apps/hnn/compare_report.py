@@ -36,14 +36,41 @@ def fmt_value(mean, se=None):
     return text if se is None else f"{text} ± {se:.1e}"
 
 
-def headline_of(section, task):
+def headline_of(section, row):
+    """The row's own (its protocol's), else the peers file's for its task, else its default."""
+    if row.get("headline"):
+        return row["headline"]
     headline = section.get("headline", {})
-    return headline.get(task, headline.get("default", "test_loss"))
+    return headline.get(row["task"], headline.get("default", "test_loss"))
+
+
+def settings_hold(peer, row):
+    """A peer's protocol settings (e.g. SRNN's {"setup": "srnn"}) are all the row's; the HNN
+    paper's Table 1 holds for a row at the task's own settings only."""
+    mine = (row.get("keys") or {}).get("settings") or {}
+    if peer.get("task_defaults_only") and mine:
+        return False
+    return all(mine.get(k) == v for k, v in (peer.get("settings") or {}).items())
+
+
+def same_pair(peer, row):
+    return (peer.get("model") is not None and peer["task"] == row["task"]
+            and peer["model"] == row["model"] and (peer.get("loss") or "derivative") == row["loss"])
 
 
 def peer_matches(peer, row):
-    return (peer.get("model") is not None and peer["task"] == row["task"]
-            and peer["model"] == row["model"] and (peer.get("loss") or "derivative") == row["loss"])
+    return same_pair(peer, row) and settings_hold(peer, row)
+
+
+def row_label(row):
+    """The task and loss cells: the protocol's settings and rollout keys when the row has them."""
+    keys = dict(row.get("keys") or {})
+    task = row["task"]
+    if keys.get("settings"):
+        task += " " + json.dumps(keys.pop("settings"))
+    loss = row["loss"]
+    extra = ", ".join(f"{k} {v}" for k, v in keys.items())
+    return task, f"{loss} ({extra})" if extra else loss
 
 
 def summarise(row, by_run):
@@ -71,8 +98,8 @@ def summarise(row, by_run):
 def row_lines(row, section, metrics, peers):
     """The table lines of a row: its headline metric, the report's metrics that its runs have,
     each peer's number on its metric (or 'not measured by hnn yet'), and the training time."""
-    wanted = [headline_of(section, row["task"])]
-    for k in section.get("report_metrics", []):
+    wanted = [headline_of(section, row)]
+    for k in section.get("report_metrics", []) + row.get("metrics", []):
         if k in metrics and k not in wanted:
             wanted.append(k)
     for p in peers:
@@ -99,6 +126,12 @@ def unmatched_reason(peer, section, rows, hnn_tasks, models_run):
     for row in rows:
         if peer_matches(peer, row) and row["skipped"]:
             return f"skipped: {row['skipped']}"
+    for row in rows:
+        if same_pair(peer, row) and not settings_hold(peer, row):
+            return ("the paper's settings are not this comparison's"
+                    if peer.get("task_defaults_only") else
+                    f"their protocol's settings {json.dumps(peer['settings'])} are not this "
+                    "comparison's")
     if peer["model"] not in models_run:
         return f"model '{peer['model']}' not in this comparison"
     return f"loss '{peer.get('loss') or 'derivative'}' not in this comparison"
@@ -113,9 +146,9 @@ def build(plan, table):
         status, done, failed, metrics = summarise(row, by_run)
         mine = [p for p in peers if peer_matches(p, row)] if not row["skipped"] else []
         rows.append({"task": row["task"], "model": row["model"], "loss": row["loss"],
-                     "status": status, "skipped": row["skipped"], "runs": row["runs"],
+                     "keys": row.get("keys") or {}, "status": status, "skipped": row["skipped"], "runs": row["runs"],
                      "seeds_done": done, "failed": failed,
-                     "headline": headline_of(section, row["task"]), "metrics": metrics,
+                     "headline": headline_of(section, row), "metrics": metrics,
                      "lines": row_lines(row, section, metrics, mine) if not row["skipped"] else []})
     tasks = {r["task"] for r in section["rows"]}
     models_run = {r["model"] for r in section["rows"] if not r["skipped"]}
@@ -173,7 +206,8 @@ def markdown(doc):
         return f" [{notes.index(text) + 1}]"
 
     for r in doc["rows"]:
-        head = f"| {r['task']} | {r['model']} | {r['loss']} |"
+        task, loss = row_label(r)
+        head = f"| {task} | {r['model']} | {loss} |"
         if r["skipped"]:
             md.append(f"{head} skipped: {r['skipped']} | | | | |")
             continue
@@ -206,45 +240,60 @@ def markdown(doc):
     if notes:
         md.append("\n## Protocols and sources\n")
         md += [f"{i + 1}. {n}" for i, n in enumerate(notes)]
-    md.append("\nChart: `accuracy_vs_time.png`, each row's headline metric against its training "
-              "time (log-log), one colour per model family and loss, one marker per task.")
+    md.append("\nChart: `accuracy_vs_time.png`, one panel per task: each row's headline metric "
+              "against its training time (log-log), one colour per model family and loss; a dashed line "
+              "at the peer's published number on the same metric.")
     return "\n".join(md) + "\n"
 
 
 def draw(doc, path):
+    """One panel per task (its headline metric differs from task to task): each row's headline
+    against its training time, log-log, one colour per model family and loss."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    markers = "osD^vP*Xh<>p"
     tasks = sweep_report.ordered(r["task"] for r in doc["rows"])
-    fig, ax = plt.subplots(figsize=(6.4, 4.6))
+    cols = min(3, len(tasks))
+    rows_n = (len(tasks) + cols - 1) // cols
+    fig, axes = plt.subplots(rows_n, cols, figsize=(4.2 * cols, 3.4 * rows_n), squeeze=False)
     colours = {}
-    drawn = False
-    for r in doc["rows"]:
-        y, x = r["metrics"].get(r["headline"]), r["metrics"].get(TIME_KEY)
-        if not y or not x or y["mean"] <= 0 or x["mean"] <= 0:
-            continue
-        family = r["model"] + ("" if r["loss"] == "derivative" else f" ({r['loss']} loss)")
-        if family not in colours:
-            colours[family] = f"C{len(colours) % 10}"
-        ax.errorbar([x["mean"]], [y["mean"]], yerr=[[min(y["se"] or 0, y["mean"] * 0.999)],
-                                                    [y["se"] or 0]],
-                    xerr=[x["se"] or 0], marker=markers[tasks.index(r["task"]) % len(markers)],
-                    color=colours[family], capsize=3, linestyle="none")
-        drawn = True
+    for ax, task in zip(axes.flat, tasks):
+        headline = title = None
+        for r in doc["rows"]:
+            if r["task"] != task:
+                continue
+            headline = headline or r["headline"]
+            title = title or row_label(r)[0]
+            y, x = r["metrics"].get(r["headline"]), r["metrics"].get(TIME_KEY)
+            if not y or not x or y["mean"] <= 0 or x["mean"] <= 0:
+                continue
+            family = r["model"] + ("" if r["loss"] == "derivative" else f" ({r['loss']} loss)")
+            colours.setdefault(family, f"C{len(colours) % 10}")
+            ax.errorbar([x["mean"]], [y["mean"]],
+                        yerr=[[min(y["se"] or 0, y["mean"] * 0.999)], [y["se"] or 0]],
+                        xerr=[[min(x["se"] or 0, x["mean"] * 0.999)], [x["se"] or 0]],
+                        marker="o", color=colours[family], capsize=3, linestyle="none")
+            for line in r["lines"]:  # the peer's number on the same metric: a dashed line
+                p = line["peer"]
+                if line["metric"] == r["headline"] and p and p["value"] > 0:
+                    ax.axhline(p["value"], color=colours[family], linestyle="--", linewidth=0.8)
+        if ax.has_data():
+            ax.set_xscale("log")
+            ax.set_yscale("log")
+        ax.set_title(title, fontsize=9)
+        ax.set_xlabel("train_seconds (s)", fontsize=8)
+        ax.set_ylabel(headline or "", fontsize=8)
+        ax.tick_params(which="both", labelsize=7)
+    for ax in list(axes.flat)[len(tasks):]:
+        ax.axis("off")
     from matplotlib.lines import Line2D
     handles = [Line2D([], [], color=c, marker="o", linestyle="none", label=f)
                for f, c in colours.items()]
-    handles += [Line2D([], [], color="grey", marker=markers[i % len(markers)], linestyle="none",
-                       label=t) for i, t in enumerate(tasks)]
-    if drawn:
-        ax.set_xscale("log")
-        ax.set_yscale("log")
-    ax.set_xlabel("training time, train_seconds (s)")
-    ax.set_ylabel("headline error (per task; compare.md)")
-    ax.set_title("accuracy against training time")
-    ax.legend(handles=handles, fontsize=7, loc="best")
-    fig.tight_layout()
+    fig.legend(handles=handles, fontsize=8, loc="lower center", ncol=max(1, len(handles)),
+               frameon=False)
+    fig.suptitle("accuracy against training time (mean ± standard error over seeds; dashed: the "
+                 "peer's published number for that family)", fontsize=10)
+    fig.tight_layout(rect=(0, 0.06, 1, 0.96))
     fig.savefig(path, dpi=120)
     plt.close(fig)
 

@@ -115,6 +115,54 @@ class Options(CompareCase):
         if "lnn" not in models:
             self.assertIn("skipped: this hnn has no", lnn[0])
         self.assertTrue(all("--steps 100" in l for l in lines if l.startswith("hnn train ")))
+        # the peers' protocols: SRNN's three-body at dt = 1 trained through leapfrog on windows
+        # of 5 points; the coarse, noisy spring; --steps over the protocol's own steps
+        rollout = [l for l in lines if l.startswith("hnn train three-body --model hnn --seed 0 ")
+                   and "--loss rollout" in l]
+        self.assertEqual(len(rollout), 1, lines)
+        for option in ("--settings '{\"setup\":\"srnn\"}'", "--integrator leapfrog",
+                       "--horizon 4", "--batch 32", "--steps 100"):
+            self.assertIn(option, rollout[0])
+        self.assertNotIn("--steps 5000", rollout[0])
+        self.assertIn('spring hnn rollout {"settings":{"sample_dt":1.0,"t_end":6},'
+                      '"integrator":"leapfrog","horizon":1}: 3 runs', lines)
+
+
+class Report(unittest.TestCase):
+    """The report's matching of a peer's protocol settings, on rows made by hand (no runs)."""
+
+    def setUp(self):
+        import sys
+        sys.path.insert(0, os.path.join(SOURCE, "apps", "hnn"))
+        import compare_report
+        self.report = compare_report
+
+    def row(self, settings=None, **keys):
+        if settings is not None:
+            keys["settings"] = settings
+        return {"task": "three-body", "model": "hnn", "loss": "rollout", "keys": keys}
+
+    def test_a_peer_s_settings_must_be_the_row_s(self):
+        srnn = {"task": "three-body", "model": "hnn", "loss": "rollout",
+                "settings": {"setup": "srnn"}, "metric": "stretch_position_error"}
+        self.assertTrue(self.report.peer_matches(srnn, self.row({"setup": "srnn"}, horizon=4)))
+        self.assertFalse(self.report.peer_matches(srnn, self.row()))
+        self.assertFalse(self.report.peer_matches(srnn, self.row({"setup": "paper"})))
+        table1 = {"task": "three-body", "model": "hnn", "loss": "rollout",
+                  "task_defaults_only": True}
+        self.assertTrue(self.report.peer_matches(table1, self.row()))
+        self.assertFalse(self.report.peer_matches(table1, self.row({"setup": "srnn"})))
+        why = self.report.unmatched_reason(srnn, {}, [{**self.row(), "skipped": None}],
+                                           ["three-body"], {"hnn"})
+        self.assertIn('settings {"setup": "srnn"} are not', why)
+
+    def test_the_row_label_shows_the_protocol(self):
+        task, loss = self.report.row_label(self.row({"setup": "srnn"}, horizon=4))
+        self.assertEqual(task, 'three-body {"setup": "srnn"}')
+        self.assertEqual(loss, "rollout (horizon 4)")
+        self.assertEqual(self.report.row_label(self.row()), ("three-body", "rollout"))
+        self.assertEqual(self.report.headline_of({"headline": {"default": "energy_mse"}},
+                                                 {**self.row(), "headline": "x"}), "x")
 
 
 class Tiny(CompareCase):
