@@ -17,6 +17,7 @@
 #include "apps/hnn/sweep_keys.h"
 #include "apps/hnn/sweep_launch.h"
 #include "apps/hnn/validators.h"
+#include "tasks/data/data_files.h"
 #include "tasks/task.h"
 
 namespace hnn::app {
@@ -75,9 +76,22 @@ std::vector<Group> default_study() {
   coarse_spring.rollout_keys = {{"integrator", "leapfrog"}, {"horizon", 1}};
   coarse_spring.headline = "stretch_state_mse";
   coarse_spring.metrics = {"truth_leapfrog_state_mse"};
+  // The D-HNN paper's real pendulum (their analysis notebook): the Lipson file through the data
+  // task, 80/20 in time, width 256, batch 128, 5000 steps at 5e-3; the energy MSE of
+  // H = 2.4 (1 - cos q) + p^2 along the held-out trajectory rolled out from its first state.
+  Group dhnn_real = crossed({"data"}, {"baseline", "hnn", "dhnn"}, {"derivative"});
+  dhnn_real.keys = {{"data", tasks::default_data_path("lipson/real_pend_h_1.txt")},
+                    {"hidden", {256, 256}},
+                    {"batch", 128},
+                    {"steps", 5000},
+                    {"lr", 5e-3},
+                    {"hamiltonian", "2.4*(1 - cos(o)) + v^2"},
+                    {"settings", {{"energy_t_end", 20}, {"rollouts", 15}}}};
+  dhnn_real.headline = "held_out_energy_mse";
+  dhnn_real.metrics = {"valid_prediction_time"};
   return {crossed({"real-pendulum", "damped-spring"}, {"baseline", "hnn", "dhnn"}, {"derivative"}),
-          crossed({"double-pendulum"}, {"baseline", "hnn", "lnn"}, {"derivative"}), three_body,
-          coarse_spring};
+          dhnn_real, crossed({"double-pendulum"}, {"baseline", "hnn", "lnn"}, {"derivative"}),
+          three_body, coarse_spring};
 }
 
 // One row of the table: a (task, model, loss) at its protocol's keys, and its runs, or why it
@@ -241,6 +255,8 @@ json read_peers(const fs::path& file) {
     need("se", !p.contains("se") || p["se"].is_null() || p["se"].is_number(), "a number");
     need("settings", !p.contains("settings") || p["settings"].is_object(),
          "an object (the run settings of their protocol)");
+    need("keys", !p.contains("keys") || p["keys"].is_object(),
+         "an object (hnn train options of their protocol)");
   }
   return doc;
 }

@@ -53,23 +53,39 @@ def settings_hold(peer, row):
     return all(mine.get(k) == v for k, v in (peer.get("settings") or {}).items())
 
 
+def keys_hold(peer, row):
+    """A peer's protocol options (e.g. the D-HNN paper's {"data": "real_pend_h_1.txt", "lr":
+    0.005}) are all the row's; a data file is compared by its name."""
+    mine = row.get("keys") or {}
+    for k, v in (peer.get("keys") or {}).items():
+        got = mine.get(k)
+        if k == "data" and isinstance(got, str):
+            got = os.path.basename(got)
+        if got != v:
+            return False
+    return True
+
+
 def same_pair(peer, row):
     return (peer.get("model") is not None and peer["task"] == row["task"]
             and peer["model"] == row["model"] and (peer.get("loss") or "derivative") == row["loss"])
 
 
 def peer_matches(peer, row):
-    return same_pair(peer, row) and settings_hold(peer, row)
+    return same_pair(peer, row) and settings_hold(peer, row) and keys_hold(peer, row)
 
 
 def row_label(row):
     """The task and loss cells: the protocol's settings and rollout keys when the row has them."""
     keys = dict(row.get("keys") or {})
     task = row["task"]
+    if keys.get("data"):
+        task += " " + os.path.basename(keys.pop("data"))
     if keys.get("settings"):
         task += " " + json.dumps(keys.pop("settings"))
     loss = row["loss"]
-    extra = ", ".join(f"{k} {v}" for k, v in keys.items())
+    extra = ", ".join(f"{k} {json.dumps(v) if isinstance(v, (str, list)) else v}"
+                      for k, v in keys.items())
     return task, f"{loss} ({extra})" if extra else loss
 
 
@@ -131,6 +147,9 @@ def unmatched_reason(peer, section, rows, hnn_tasks, models_run):
             return ("the paper's settings are not this comparison's"
                     if peer.get("task_defaults_only") else
                     f"their protocol's settings {json.dumps(peer['settings'])} are not this "
+                    "comparison's")
+        if same_pair(peer, row) and not keys_hold(peer, row):
+            return (f"their protocol's options {json.dumps(peer['keys'])} are not this "
                     "comparison's")
     if peer["model"] not in models_run:
         return f"model '{peer['model']}' not in this comparison"

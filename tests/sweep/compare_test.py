@@ -126,6 +126,12 @@ class Options(CompareCase):
         self.assertNotIn("--steps 5000", rollout[0])
         self.assertIn('spring hnn rollout {"settings":{"sample_dt":1.0,"t_end":6},'
                       '"integrator":"leapfrog","horizon":1}: 3 runs', lines)
+        # the D-HNN paper's real pendulum: the shipped Lipson file through the data task
+        dhnn = [l for l in lines if l.startswith("hnn train data --model dhnn --seed 0 ")]
+        self.assertEqual(len(dhnn), 1, lines)
+        for option in ("--hidden 256 256", "--batch 128", "--lr 0.005", "real_pend_h_1.txt",
+                       "--hamiltonian '2.4*(1 - cos(o)) + v^2'"):
+            self.assertIn(option, dhnn[0])
 
 
 class Report(unittest.TestCase):
@@ -155,6 +161,20 @@ class Report(unittest.TestCase):
         why = self.report.unmatched_reason(srnn, {}, [{**self.row(), "skipped": None}],
                                            ["three-body"], {"hnn"})
         self.assertIn('settings {"setup": "srnn"} are not', why)
+
+    def test_a_peer_s_options_must_be_the_row_s(self):
+        dhnn = {"task": "data", "model": "dhnn", "loss": "derivative",
+                "keys": {"data": "real_pend_h_1.txt", "lr": 0.005}}
+        row = {"task": "data", "model": "dhnn", "loss": "derivative",
+               "keys": {"data": "/any/folder/real_pend_h_1.txt", "lr": 0.005, "batch": 128}}
+        self.assertTrue(self.report.peer_matches(dhnn, row))
+        self.assertFalse(self.report.peer_matches(dhnn, {**row, "keys": {"lr": 0.005}}))
+        other = {**row, "keys": {"data": "/f/real_pend_h_1.txt", "lr": 0.001}}
+        self.assertFalse(self.report.peer_matches(dhnn, other))
+        why = self.report.unmatched_reason(dhnn, {}, [{**other, "skipped": None}], ["data"],
+                                           {"dhnn"})
+        self.assertIn("options", why)
+        self.assertEqual(self.report.row_label(row)[0], "data real_pend_h_1.txt")
 
     def test_the_row_label_shows_the_protocol(self):
         task, loss = self.report.row_label(self.row({"setup": "srnn"}, horizon=4))
