@@ -14,6 +14,8 @@ namespace hnn::ad::detail {
 
 /// Output widths below this go through gemm's narrow path.
 inline constexpr Eigen::Index kNarrow = 16;
+/// Elements of the narrow path's B^T on the stack (80 KiB of double): kNarrow x 640.
+inline constexpr Eigen::Index kStackedNarrow = kNarrow * 640;
 
 /// Call once before the first gemm: OpenBLAS must not start threads of its own.
 void init_gemm();
@@ -33,10 +35,21 @@ void gemm(const A& a, bool ta, const B& b, bool tb, C&& c, typename A::Scalar be
   if (!ta && !tb && n < kNarrow) {
     // OpenBLAS 0.3.21's small-matrix kernel for A B with a narrow B (an MLP's last layer)
     // mallocs on every call; A (B^T)^T takes another path, and B^T costs at most kNarrow x k.
-    thread_local Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> b_t;
-    b_t.resize(n, k);  // reallocates only when the shape changes
-    b_t = b.transpose();
-    b_data = b_t.data();
+    // B^T lives on the stack up to kStackedNarrow elements: a thread-local copy would be sized
+    // by whichever thread first runs a part, and parts go to whoever claims them (Note [Claimed
+    // parts]), so a worker could allocate it in any later step.
+    using RowMatrix = Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+    // (A thread-local is set up, and registered for destruction with a calloc, where control
+    // first passes its declaration: hence inside the branch.)
+    alignas(64) T stacked[kStackedNarrow];
+    T* b_t = stacked;
+    if (n * k > kStackedNarrow) {
+      thread_local RowMatrix wide;  // B^T of more than kStackedNarrow elements (widths over 640)
+      wide.resize(n, k);
+      b_t = wide.data();
+    }
+    Eigen::Map<RowMatrix>(b_t, n, k) = b.transpose();
+    b_data = b_t;
     ldb = int(k);
     tb = true;
   }
