@@ -56,35 +56,39 @@ class Dhnn(torch.nn.Module):
 
 
 class Lnn(torch.nn.Module):
-    """The LNN: L(q, v) from an MLP that sees the angles wrapped to [-pi, pi) and x / scale (the
-    double-pendulum task's input: 2 angles, scales 1, 1, 10, 10); dv/dt from Euler-Lagrange."""
+    """The LNN as hnn's double-pendulum task builds it (nn::DynamicsModel::mlp_input): the state
+    divided by its scales (1, 1, 10, 10), the angles given to the MLP as (cos, sin), and the
+    kinetic prior L = MLP(x~) + prior |v~|^2 / 2 on the scaled velocities; dv/dt from
+    Euler-Lagrange."""
 
-    def __init__(self, dim, hidden, activation, angles=2, scale=(1.0, 1.0, 10.0, 10.0)):
+    def __init__(self, dim, hidden, activation, angles=2, scale=(1.0, 1.0, 10.0, 10.0),
+                 kinetic_prior=1.0):
         super().__init__()
-        self.half, self.angles = dim // 2, angles
-        self.mlp = DeepMlp([dim, *hidden, 1], activation)
+        self.half, self.angles, self.prior = dim // 2, angles, kinetic_prior
+        self.mlp = DeepMlp([dim + angles, *hidden, 1], activation)
         self.register_buffer("inv_scale", 1.0 / torch.tensor(scale, dtype=torch.float64))
 
-    def lagrangian(self, q, v, shift):
-        """L of one state; `shift` is its angles' wrap (a constant, as in hnn's mlp_input)."""
-        return self.mlp((torch.cat([q, v]) - shift) * self.inv_scale).squeeze(-1)
+    def lagrangian(self, q, v):
+        """L of one state."""
+        x = torch.cat([q, v]) * self.inv_scale.to(q.dtype)
+        a = x[:self.angles]
+        features = torch.cat([torch.cos(a), torch.sin(a), x[self.angles:]])
+        kinetic = 0.5 * self.prior * (x[self.half:] ** 2).sum()
+        return self.mlp(features).squeeze(-1) + kinetic
 
-    def equation_of_motion(self, q, v, shift):
+    def equation_of_motion(self, q, v):
         """Cranmer et al.'s: (d2L/dv2)^-1 (dL/dq - (d2L/dv dq) v), with a solve for their pinv."""
-        h_vv = hessian(self.lagrangian, argnums=1)(q, v, shift)
-        g_q = grad(self.lagrangian, argnums=0)(q, v, shift)
-        h_vq = jacfwd(grad(self.lagrangian, argnums=1), argnums=0)(q, v, shift)
+        h_vv = hessian(self.lagrangian, argnums=1)(q, v)
+        g_q = grad(self.lagrangian, argnums=0)(q, v)
+        h_vq = jacfwd(grad(self.lagrangian, argnums=1), argnums=0)(q, v)
         return torch.linalg.solve(h_vv, g_q - h_vq @ v)
 
     def forward(self, x, create_graph=True):
         n = self.half
-        shift = torch.zeros_like(x)
-        two_pi = 2 * math.pi
-        shift[:, :self.angles] = torch.floor((x[:, :self.angles] + math.pi) / two_pi) * two_pi
         # Without a graph of the parameters for evaluation: functorch's transforms ignore an
         # outer no_grad, so the derivatives in x are still taken.
         with torch.set_grad_enabled(create_graph):
-            a = vmap(self.equation_of_motion)(x[:, :n], x[:, n:], shift)
+            a = vmap(self.equation_of_motion)(x[:, :n], x[:, n:])
         return torch.cat([x[:, n:], a], 1)
 
 
