@@ -54,8 +54,8 @@ void gemm(const A& a, bool ta, const B& b, bool tb, C&& c, typename A::Scalar be
     tb = true;
   }
   if constexpr (std::is_same_v<T, float>) {
-    cblas_sgemm(CblasRowMajor, op(ta), op(tb), int(m), int(n), int(k), 1.0f, a.data(), lda,
-                b_data, ldb, beta, c.data(), ldc);
+    cblas_sgemm(CblasRowMajor, op(ta), op(tb), int(m), int(n), int(k), 1.0f, a.data(), lda, b_data,
+                ldb, beta, c.data(), ldc);
   } else {
     cblas_dgemm(CblasRowMajor, op(ta), op(tb), int(m), int(n), int(k), 1.0, a.data(), lda, b_data,
                 ldb, beta, c.data(), ldc);

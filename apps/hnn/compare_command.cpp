@@ -14,6 +14,7 @@
 #include <set>
 
 #include "apps/hnn/commands.h"
+#include "apps/hnn/compare_peers.h"
 #include "apps/hnn/sweep_keys.h"
 #include "apps/hnn/sweep_launch.h"
 #include "apps/hnn/validators.h"
@@ -215,92 +216,6 @@ std::vector<Row> rows_of(const std::vector<Group>& groups) {
   return rows;
 }
 
-// ---- the peers' numbers ----------------------------------------------------------------------
-
-fs::path own_executable() { return fs::read_symlink("/proc/self/exe"); }
-
-// $HNN_PEERS, the installed share/hnn/peers.json, or the source tree's tasks/report/peers.json.
-fs::path peers_path() {
-  if (const char* env = std::getenv("HNN_PEERS")) return env;
-  const fs::path installed =
-      own_executable().parent_path().parent_path() / "share" / "hnn" / "peers.json";
-  if (fs::exists(installed)) return installed;
-  return HNN_PEERS_SOURCE;
-}
-
-// The peers file, checked entry by entry: one line naming the file and the entry otherwise.
-json read_peers(const fs::path& file) {
-  std::ifstream in(file);
-  const auto bad = [&](const std::string& what) {
-    return std::invalid_argument(fmt::format("peers file {}: {}", file.string(), what));
-  };
-  if (!in) throw bad("cannot be read (HNN_PEERS names another)");
-  const json doc = json::parse(in, nullptr, /*allow_exceptions=*/false);
-  if (!doc.is_object() || !doc.contains("peers") || !doc["peers"].is_array())
-    throw bad("expected an object with a \"peers\" list");
-  for (std::size_t i = 0; i < doc["peers"].size(); ++i) {
-    const json& p = doc["peers"][i];
-    const auto need = [&](const char* key, bool ok, const char* what) {
-      if (!ok) throw bad(fmt::format("entry {}: '{}' must be {}", i + 1, key, what));
-    };
-    need("peer", p.contains("peer") && p["peer"].is_string(), "a string");
-    need("source", p.contains("source") && p["source"].is_string(), "a string");
-    need("task", p.contains("task") && p["task"].is_string(), "a string");
-    need("peer_model", p.contains("peer_model") && p["peer_model"].is_string(), "a string");
-    need("value", p.contains("value") && p["value"].is_number(), "a number");
-    need("model", !p.contains("model") || p["model"].is_null() || p["model"].is_string(),
-         "an hnn model family or null");
-    need("metric", !p.contains("metric") || p["metric"].is_null() || p["metric"].is_string(),
-         "a metrics.json key or null");
-    need("se", !p.contains("se") || p["se"].is_null() || p["se"].is_number(), "a number");
-    need("settings", !p.contains("settings") || p["settings"].is_object(),
-         "an object (the run settings of their protocol)");
-    need("keys", !p.contains("keys") || p["keys"].is_object(),
-         "an object (hnn train options of their protocol)");
-  }
-  return doc;
-}
-
-constexpr const char* kTable1Protocol =
-    "the HNN paper's settings (each task's defaults); train and test loss: MSE of dx/dt over the "
-    "split; energy: MSE of the true energy along true and learned rollouts";
-
-// The HNN paper's Table 1 for the study's paper tasks: Task::paper(), the numbers `hnn
-// reproduce` sets beside its own.
-json table1_peers(const std::vector<Row>& rows) {
-  json out = json::array();
-  const std::vector<std::string> paper_tasks = tasks::paper_task_names();
-  std::set<std::string> done;
-  for (const Row& row : rows) {
-    // A row at other settings than the task's own (a peer's protocol) is not Table 1's.
-    if (!contains(paper_tasks, row.task) || !row.keys.empty() || !done.insert(row.task).second)
-      continue;
-    const auto task = tasks::make_task(row.task);
-    for (const nn::ModelKind model : {nn::ModelKind::kBaseline, nn::ModelKind::kHnn}) {
-      const tasks::PaperRow paper = task->paper(model);
-      const std::pair<const char*, tasks::PaperValue> values[] = {{"train_loss", paper.train_loss},
-                                                                  {"test_loss", paper.test_loss},
-                                                                  {"energy_mse", paper.energy_mse}};
-      for (const auto& [metric, v] : values) {
-        out.push_back({{"peer", "HNN (Greydanus et al. 2019)"},
-                       {"source", "the HNN paper's Table 1 (hnn: Task::paper() of tasks/" +
-                                      row.task + ", as hnn reproduce's table1.md)"},
-                       {"task", row.task},
-                       {"model", nn::to_string(model)},
-                       {"loss", "derivative"},
-                       {"peer_model", model == nn::ModelKind::kHnn ? "HNN" : "baseline MLP"},
-                       {"metric", metric},
-                       {"value", v.mean},
-                       {"se", v.se},
-                       {"n", "the paper's seeds"},
-                       {"protocol", kTable1Protocol},
-                       {"task_defaults_only", true}});
-      }
-    }
-  }
-  return out;
-}
-
 json rows_json(const std::vector<Row>& rows) {
   json out = json::array();
   for (const Row& r : rows) {
@@ -319,7 +234,11 @@ json rows_json(const std::vector<Row>& rows) {
 json compare_section(const std::vector<Row>& rows, const CompareOptions& o) {
   const fs::path file = peers_path();
   json peers_doc = read_peers(file);
-  json peers = table1_peers(rows);
+  std::vector<std::string> own_settings;  // tasks with rows at their own settings: Table 1's
+  for (const Row& row : rows) {
+    if (row.keys.empty() && !contains(own_settings, row.task)) own_settings.push_back(row.task);
+  }
+  json peers = table1_peers(own_settings);
   for (const json& p : peers_doc["peers"]) peers.push_back(p);
   return {{"command", o.command},
           {"seeds", o.seeds},
