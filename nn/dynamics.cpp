@@ -211,26 +211,45 @@ ad::Var<T> DynamicsModel<T>::mlp_input(const ad::Var<T>& x) const {
   return concat<T>({ad::cos(angle), ad::sin(angle), ad::slice_cols(in, a, in.cols() - a)});
 }
 
-// The chain rule through the embedding: d/dθ = -sin θ d/dcos + cos θ d/dsin; then 1 / scale.
+namespace {
+
+// One output's gradient at the MLP's input (R x (dim + angles)) carried back to the state: the
+// chain rule through the embedding, d/dθ = -sin θ d/dcos + cos θ d/dsin, then 1 / scale.
 template <typename T>
-ad::Var<T> DynamicsModel<T>::input_gradient(const ad::Var<T>& x, Index column) const {
-  ad::Var<T> g = mlp_.input_gradient(mlp_input(x), column);
-  const Index a = config_.angles;
+ad::Var<T> to_state_gradient(const DynamicsConfig& config, const ad::Var<T>& x, ad::Var<T> g) {
+  const Index a = config.angles;
   if (a > 0) {
     const ad::Var<T> angle = ad::slice_cols(x, 0, a);
     const ad::Var<T> d_angle =
         ad::cos(angle) * ad::slice_cols(g, a, a) - ad::sin(angle) * ad::slice_cols(g, 0, a);
     g = concat<T>({d_angle, ad::slice_cols(g, 2 * a, g.cols() - 2 * a)});
   }
-  if (config_.input_scale.empty()) return g;
-  return g * inverse_scale<T>(config_.input_scale);
+  if (config.input_scale.empty()) return g;
+  return g * inverse_scale<T>(config.input_scale);
+}
+
+}  // namespace
+
+template <typename T>
+ad::Var<T> DynamicsModel<T>::input_gradient(const ad::Var<T>& x, Index column) const {
+  return to_state_gradient(config_, x, mlp_.input_gradient(mlp_input(x), column));
 }
 
 template <typename T>
 ad::Var<T> DynamicsModel<T>::input_gradients(const ad::Var<T>& x) const {
   const ad::Var<T> g = mlp_.input_gradients(mlp_input(x));
-  if (config_.input_scale.empty()) return g;
-  return g * inverse_scale<T>(config_.input_scale, mlp_.output_dim());
+  if (config_.angles == 0) {  // every output's block scaled by one op
+    if (config_.input_scale.empty()) return g;
+    return g * inverse_scale<T>(config_.input_scale, mlp_.output_dim());
+  }
+  const Index width = x.cols() + config_.angles;  // one output's block of g
+  thread_local std::vector<ad::Var<T>> blocks;    // reused: no allocation per step
+  blocks.clear();
+  for (Index j = 0; j < mlp_.output_dim(); ++j)
+    blocks.push_back(to_state_gradient(config_, x, ad::slice_cols(g, j * width, width)));
+  const ad::Var<T> all = ad::concat_cols<T>(blocks);
+  blocks.clear();  // release the handles (capacity stays)
+  return all;
 }
 
 template class DynamicsModel<float>;

@@ -184,6 +184,25 @@ void expect_dissipative_routes_agree(double tolerance) {
   }
 }
 
+// A D-HNN's dH/dx and dD/dx come from one op (input_gradients); with angles seen as (cos, sin)
+// and input scales, each block still goes back through the embedding to the state.
+TEST(Hnn, BothGradientsGoThroughTheAngleEmbeddingAndTheScales) {
+  std::mt19937_64 rng(14);
+  nn::DynamicsConfig config = small_config(ModelKind::kDhnn, 2, {12}, FieldType::kBoth);
+  config.angles = 1;
+  config.input_scale = {1, 3};
+  const nn::Hnn<double> model(config, rng);
+  const MatrixD x = random_states(6, 2, 15) * 4.0;  // angles across +-pi
+  ad::TapeScope scope;
+  const Var<double> xv = Var<double>::leaf(x);
+  const nn::Hnn<double>::Parts parts = model.time_derivative_parts(xv);
+  const MatrixD dh = ad::grad<double>({ad::sum(model.energy(xv))}, {xv})[0].value();
+  const MatrixD dd = ad::grad<double>({ad::sum(model.dissipation(xv))}, {xv})[0].value();
+  const MatrixD sym = (MatrixD(6, 2) << dh.col(1), -dh.col(0)).finished();
+  EXPECT_LT((parts.solenoidal.value() - sym).cwiseAbs().maxCoeff(), 1e-14);
+  EXPECT_LT((parts.conservative.value() - dd).cwiseAbs().maxCoeff(), 1e-14);
+}
+
 TEST(Hnn, DissipativeFieldMatchesTheGenericFormulaToSecondOrder) {
   expect_dissipative_routes_agree<double>(1e-12);
   expect_dissipative_routes_agree<float>(1e-4);
