@@ -249,7 +249,8 @@ double pixel_gemm_rate() {
   return 3 * 2.0 * kPixelRows * kPixels * kWidth / times[10];
 }
 
-// The trainer's step (tasks/pixel_pendulum.cpp) on random frames: loss, gradients, Adam.
+// The trainer's step (tasks/experiments/pixel_pendulum.cpp) on random frames: loss, gradients,
+// Adam.
 template <typename T>
 void BM_PixelRoofline(benchmark::State& state) {
   const auto kind = state.range(0) == 0 ? nn::ModelKind::kHnn

@@ -7,8 +7,8 @@
 #include <cmath>
 #include <sstream>
 
+#include "tasks/error.h"
 #include "tasks/report/json_values.h"
-#include "tasks/task.h"
 
 namespace hnn::tasks {
 
@@ -39,31 +39,6 @@ std::vector<int> widths_from_json(const json& j) {
   for (int w : widths)
     if (w < 1 || w > kMaxWidth) throw bad();
   return widths;
-}
-
-void check_train_config(const TrainConfig& c) {
-  HNN_TASKS_CHECK(c.steps > 0, "--steps must be positive, got {}", c.steps);
-  HNN_TASKS_CHECK(c.batch_size >= 0, "--batch must be >= 0, got {}", c.batch_size);
-  HNN_TASKS_CHECK(c.learning_rate > 0 && std::isfinite(c.learning_rate),
-                  "--lr must be a positive finite number, got {}", c.learning_rate);
-  HNN_TASKS_CHECK(c.weight_decay >= 0 && std::isfinite(c.weight_decay),
-                  "weight decay must be a finite number >= 0, got {}", c.weight_decay);
-  HNN_TASKS_CHECK(!c.hidden.empty(), "--hidden needs at least one width");
-  for (int w : c.hidden) {
-    HNN_TASKS_CHECK(w > 0 && w <= kMaxWidth, "--hidden widths must be 1..{}, got {}", kMaxWidth, w);
-  }
-}
-
-TrainConfig train_config(const Task& task, const RunOptions& o) {
-  TrainConfig c = task.train_config();
-  if (o.preset == Preset::kLean) c.hidden = task.lean_hidden();
-  if (o.steps) c.steps = *o.steps;
-  if (o.batch_size) c.batch_size = *o.batch_size;
-  if (o.hidden) c.hidden = *o.hidden;
-  if (o.learning_rate) c.learning_rate = *o.learning_rate;
-  if (o.weight_decay) c.weight_decay = *o.weight_decay;
-  if (o.lr_schedule) c.lr_schedule = *o.lr_schedule;
-  return c;
 }
 
 }  // namespace
@@ -97,65 +72,6 @@ nn::ModelKind parse_model(std::string_view name) {
 std::string join_widths(const std::vector<int>& widths) {
   std::string s;
   for (int w : widths) s += (s.empty() ? "" : "-") + std::to_string(w);
-  return s;
-}
-
-namespace {
-
-// Why a model that needs velocities does not fit a task, and which tasks it fits.
-std::string needs_velocities_note(nn::ModelKind model) {
-  if (!nn::needs_velocities(model)) return "";
-  std::vector<std::string> fits;
-  for (const std::string& name : task_names()) {
-    const std::vector<nn::ModelKind> models = make_task(name)->models();
-    if (std::find(models.begin(), models.end(), model) != models.end()) fits.push_back(name);
-  }
-  return fmt::format(
-      ": an {} learns L(q, dq/dt) from coordinates and their velocities, which "
-      "this task's states are not (tasks that have them: {})",
-      nn::to_string(model), fmt::join(fits, ", "));
-}
-
-}  // namespace
-
-RunSettings resolve(const Task& task, const RunOptions& o) {
-  HNN_TASKS_CHECK(o.threads >= 1 && o.threads <= 256, "--threads must be 1..256, got {}",
-                  o.threads);
-  HNN_TASKS_CHECK(o.data_file.empty() || task.reads_data_file(),
-                  "task '{}' does not read a data file (--data applies to measured-data tasks "
-                  "such as real-pendulum)",
-                  task.name());
-  HNN_TASKS_CHECK(o.task_settings.is_object(), "task settings must be a JSON object, got {}",
-                  o.task_settings.dump());
-  task.check_task_settings(o.task_settings);
-  const std::vector<nn::ModelKind> models = task.models();
-  if (std::find(models.begin(), models.end(), o.model) == models.end()) {
-    std::vector<std::string_view> names;
-    for (nn::ModelKind m : models) names.push_back(nn::to_string(m));
-    throw Error(fmt::format("task '{}' does not train a {} model (its models: {}){}", task.name(),
-                            nn::to_string(o.model), fmt::join(names, ", "),
-                            needs_velocities_note(o.model)));
-  }
-  RunSettings s{.task = task.name(),
-                .model = o.model,
-                .seed = o.seed,
-                .dtype = o.dtype,
-                .preset = o.preset,
-                .threads = o.threads,
-                .train = train_config(task, o),
-                .data_file = o.data_file,
-                .task_settings = o.task_settings};
-  check_train_config(s.train);
-  return s;
-}
-
-RunSettings validate(const RunOptions& o) {
-  const RunSettings s = resolve(*make_task(o.task), o);
-  HNN_TASKS_CHECK(!o.checkpoint_every || *o.checkpoint_every > 0,
-                  "--checkpoint-every must be positive, got {}", o.checkpoint_every.value_or(0));
-  HNN_TASKS_CHECK(!o.out.empty(), "an output folder is required");
-  HNN_TASKS_CHECK(!std::filesystem::exists(o.out) || std::filesystem::is_directory(o.out),
-                  "--out '{}' is a file, not a folder", o.out.string());
   return s;
 }
 

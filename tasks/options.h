@@ -16,8 +16,6 @@
 
 namespace hnn::tasks {
 
-class Task;
-
 /// The widest hidden layer a run may ask for (a typo like 20000 would need gigabytes).
 inline constexpr int kMaxWidth = 4096;
 
@@ -92,12 +90,6 @@ struct RunOptions {
   /// Polled by the training loop (e.g. set on SIGINT): checkpoint and stop after the step.
   StopSignal* stop = nullptr;
 };
-
-/// The task's defaults under the preset, with the options' overrides; throws Error naming the
-/// first bad value (including an option the task does not honour).
-RunSettings resolve(const Task& task, const RunOptions& options);
-/// resolve() against make_task(options.task), and the options that resolve does not see.
-RunSettings validate(const RunOptions& options);
 
 /// The options that rebuild a run from RunSettings::to_json (metrics.json or a checkpoint's
 /// settings): every setting as an override. Throws Error naming `where` and the bad key.

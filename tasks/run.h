@@ -15,6 +15,12 @@
 
 namespace hnn::tasks {
 
+/// The task's defaults under the preset, with the options' overrides; throws Error naming the
+/// first bad value (including an option the task does not honour).
+RunSettings resolve(const Task& task, const RunOptions& options);
+/// resolve() against make_task(options.task), and the options that resolve does not see.
+RunSettings validate(const RunOptions& options);
+
 /// Trains and evaluates one model; writes the run folder `options.out` and returns metrics.json's
 /// content. Throws on bad options or data (nothing half-written is left: each file is atomic).
 nlohmann::json run_training(const RunOptions& options);

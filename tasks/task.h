@@ -78,10 +78,10 @@ class Task {
   virtual PaperRow paper(nn::ModelKind model) const = 0;
   /// A paragraph under Table 1 when this task's metrics mean something particular.
   virtual std::string table_note() const { return ""; }
-  /// A figure comparing a baseline run and an HNN run of this task (folders of run_training)
-  /// into `out`, for `hnn reproduce`; by default none.
-  virtual void write_comparison(const std::filesystem::path& baseline_run,
-                                const std::filesystem::path& hnn_run,
+  /// A figure comparing a trained baseline run and a trained HNN run of this task into `out`,
+  /// for `hnn reproduce`, when has_comparison(); by default none.
+  virtual bool has_comparison() const { return false; }
+  virtual void write_comparison(const TaskRun& baseline, const TaskRun& hnn,
                                 const std::filesystem::path& out) const;
   /// The model kinds a run of this task can train: by default hnn, baseline and dhnn.
   virtual std::vector<nn::ModelKind> models() const {
@@ -95,14 +95,5 @@ class Task {
   /// Builds the run's data (deterministic: the same settings give the same data, bit for bit).
   virtual std::unique_ptr<TaskRun> open(const RunSettings& settings) const = 0;
 };
-
-/// The tasks by name: spring, pendulum, real-pendulum, two-body, three-body, pixel-pendulum (the
-/// paper's), damped-spring (the dissipative-HNN paper's), double-pendulum (the LNN paper's),
-/// real-double-pendulum (measured) and data (a user's own file). Throws Error naming the known
-/// tasks for any other name.
-std::unique_ptr<Task> make_task(const std::string& name);
-std::vector<std::string> task_names();
-/// The paper's six: what `hnn reproduce` runs by default.
-std::vector<std::string> paper_task_names();
 
 }  // namespace hnn::tasks

@@ -10,7 +10,8 @@
 #include <physics/autodiff/autodiff_system.h>
 #include <physics/integrator.h>
 #include <tasks/evaluate/rollouts.h>
-#include <tasks/field_task.h>
+#include <tasks/field/field_model_run.h>
+#include <tasks/field/field_task.h>
 
 #include <chrono>
 #include <random>

@@ -13,6 +13,7 @@
 #include <sstream>
 #include <string>
 
+#include "tasks/experiments/registry.h"
 #include "tasks/task.h"
 
 namespace {

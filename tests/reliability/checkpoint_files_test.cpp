@@ -12,7 +12,9 @@
 #include "nn/checkpoint.h"
 #include "nn/hnn.h"
 #include "reliability_util.h"
-#include "tasks/field_task.h"
+#include "tasks/experiments/registry.h"
+#include "tasks/field/field_model_run.h"
+#include "tasks/field/field_task.h"
 #include "tasks/train/checkpoint.h"
 #include "tasks/train/loop.h"
 

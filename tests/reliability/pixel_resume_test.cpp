@@ -9,7 +9,7 @@
 #include <map>
 
 #include "reliability_util.h"
-#include "tasks/pixel_pendulum.h"
+#include "tasks/experiments/pixel_pendulum.h"
 #include "tasks/report/run_folder.h"
 #include "tasks/run.h"
 #include "tasks/train/checkpoint.h"

@@ -139,7 +139,8 @@ class Report(unittest.TestCase):
 
     def setUp(self):
         import sys
-        sys.path.insert(0, os.path.join(SOURCE, "apps", "hnn"))
+        sys.path.insert(0, os.path.join(SOURCE, "apps", "hnn", "sweep"))
+        sys.path.insert(0, os.path.join(SOURCE, "apps", "hnn", "compare"))
         import compare_report
         self.report = compare_report
 

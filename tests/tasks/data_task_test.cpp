@@ -9,6 +9,7 @@
 
 #include "physics/expression_system.h"
 #include "tasks/data/units.h"
+#include "tasks/experiments/registry.h"
 #include "tasks/task.h"
 #include "test_configs.h"
 

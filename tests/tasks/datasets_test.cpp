@@ -9,7 +9,9 @@
 #include <sstream>
 
 #include "physics/integrator.h"
-#include "tasks/field_task.h"
+#include "tasks/experiments/registry.h"
+#include "tasks/field/field_task.h"
+#include "tasks/run.h"
 #include "tests/tasks/test_configs.h"
 
 namespace hnn::tasks {

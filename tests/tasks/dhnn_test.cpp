@@ -5,7 +5,8 @@
 
 #include "nn/hnn.h"
 #include "physics/oscillators.h"
-#include "tasks/field_task.h"
+#include "tasks/experiments/registry.h"
+#include "tasks/field/field_task.h"
 #include "test_configs.h"
 
 namespace hnn::tasks {

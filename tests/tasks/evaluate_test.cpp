@@ -11,7 +11,8 @@
 #include "physics/integrator.h"
 #include "tasks/evaluate/field_evaluation.h"
 #include "tasks/evaluate/rollouts.h"
-#include "tasks/field_task.h"
+#include "tasks/experiments/registry.h"
+#include "tasks/field/field_task.h"
 #include "tasks/train/field_objective.h"
 #include "tests/tasks/test_configs.h"
 

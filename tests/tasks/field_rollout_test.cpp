@@ -4,7 +4,9 @@
 
 #include <gtest/gtest.h>
 
-#include "tasks/field_task.h"
+#include "tasks/experiments/registry.h"
+#include "tasks/field/field_task.h"
+#include "tasks/run.h"
 #include "test_configs.h"
 
 namespace hnn::tasks {

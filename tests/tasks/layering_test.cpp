@@ -16,23 +16,32 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// Each folder of tasks/ ("" is the root: the Task interface, experiments, runs) and the tasks/
-// folders its library may include. tasks/error.h is shared by all.
+// Each layer of tasks/ and the layers its files may include. The root holds two layers: the
+// Task interface with the typed options ("", every root file but run.h/.cpp), which the
+// frameworks and experiments build on, and the run end to end ("run"), which looks experiments
+// up by name. tasks/error.h is shared by all.
 const std::map<std::string, std::set<std::string>>& allowed() {
-  static const std::map<std::string, std::set<std::string>> folders = {
+  static const std::map<std::string, std::set<std::string>> layers = {
       {"report", {"report"}},
       {"data", {"data"}},
       {"train", {"train", "data", "report"}},
       {"evaluate", {"evaluate", "data", "report"}},
       {"pixel", {"pixel", "train", "evaluate", "data", "report"}},
-      {"", {"", "pixel", "train", "evaluate", "data", "report"}}};
-  return folders;
+      {"", {"", "train", "evaluate", "data", "report"}},
+      {"field", {"field", "", "train", "evaluate", "data", "report"}},
+      {"experiments", {"experiments", "field", "", "pixel", "train", "evaluate", "data", "report"}},
+      {"run", {"run", "experiments", "field", "", "pixel", "train", "evaluate", "data", "report"}},
+      {"studies",
+       {"studies", "run", "experiments", "field", "", "pixel", "train", "evaluate", "data",
+        "report"}}};
+  return layers;
 }
 
-// "tasks/train/loop.h" -> "train"; "tasks/run.h" -> "".
+// "tasks/train/loop.h" -> "train"; "tasks/run.h" -> "run"; "tasks/task.h" -> "".
 std::string folder_of(const std::string& include) {
   const fs::path path = fs::path(include).lexically_relative("tasks");
-  return std::distance(path.begin(), path.end()) > 1 ? path.begin()->string() : "";
+  if (std::distance(path.begin(), path.end()) > 1) return path.begin()->string();
+  return path.stem() == "run" ? "run" : "";
 }
 
 TEST(Layering, EveryTasksFolderIncludesOnlyWhatItLinks) {
@@ -54,6 +63,20 @@ TEST(Layering, EveryTasksFolderIncludesOnlyWhatItLinks) {
     }
   }
   EXPECT_GT(files, 30);
+}
+
+// The root holds only the interface, the options and the run: experiments, frameworks and
+// studies each have their folder.
+TEST(Layering, TheRootHoldsOnlyTheInterfaceTheOptionsAndTheRun) {
+  const std::set<std::string> root_files = {"error.h",   "task.h",          "task.cpp",
+                                            "options.h", "options.cpp",     "run.h",
+                                            "run.cpp",   "trained_model.h", "CMakeLists.txt"};
+  for (const fs::directory_entry& entry :
+       fs::directory_iterator(fs::path(HNN_SOURCE_DIR) / "tasks")) {
+    if (entry.is_directory()) continue;
+    EXPECT_TRUE(root_files.count(entry.path().filename().string()))
+        << entry.path() << " belongs in a folder of tasks/";
+  }
 }
 
 }  // namespace

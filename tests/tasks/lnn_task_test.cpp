@@ -7,7 +7,8 @@
 #include <cmath>
 
 #include "physics/double_pendulum.h"
-#include "tasks/field_task.h"
+#include "tasks/experiments/registry.h"
+#include "tasks/field/field_task.h"
 #include "test_configs.h"
 
 namespace hnn::tasks {

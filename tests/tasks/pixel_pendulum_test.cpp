@@ -2,7 +2,7 @@
 // steps): data offsets and shapes, the loss, training, the run folder with its GIF and PNG
 // (decoded again with giflib and libpng), the energy bump, and reversibility.
 
-#include "tasks/pixel_pendulum.h"
+#include "tasks/experiments/pixel_pendulum.h"
 
 #include <gtest/gtest.h>
 
@@ -14,6 +14,7 @@
 #include "autodiff/ops.h"
 #include "autodiff/tape.h"
 #include "tasks/evaluate/reversibility.h"
+#include "tasks/experiments/registry.h"
 #include "tasks/pixel/bump.h"
 #include "tasks/pixel/objective.h"
 #include "tasks/report/image_io.h"

@@ -6,7 +6,8 @@
 
 #include <algorithm>
 
-#include "tasks/field_task.h"
+#include "tasks/experiments/registry.h"
+#include "tasks/field/field_task.h"
 #include "tasks/run.h"
 #include "tests/tasks/test_configs.h"
 

@@ -9,7 +9,8 @@
 
 #include "tasks/evaluate/field_evaluation.h"
 #include "tasks/evaluate/rollouts.h"
-#include "tasks/field_task.h"
+#include "tasks/experiments/registry.h"
+#include "tasks/field/field_task.h"
 #include "tests/tasks/test_configs.h"
 
 namespace hnn::tasks {

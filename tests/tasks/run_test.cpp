@@ -9,8 +9,9 @@
 
 #include <cmath>
 
+#include "tasks/experiments/registry.h"
 #include "tasks/report/table1.h"
-#include "tasks/reproduce.h"
+#include "tasks/studies/reproduce.h"
 #include "tasks/task.h"
 #include "tests/tasks/test_configs.h"
 

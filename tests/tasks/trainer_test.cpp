@@ -9,7 +9,9 @@
 #include "nn/checkpoint.h"
 #include "nn/hnn.h"
 #include "tasks/evaluate/rollouts.h"
-#include "tasks/field_task.h"
+#include "tasks/experiments/registry.h"
+#include "tasks/field/field_model_run.h"
+#include "tasks/field/field_task.h"
 #include "tasks/train/field_objective.h"
 #include "tests/tasks/test_configs.h"
 

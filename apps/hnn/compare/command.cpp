@@ -1,0 +1,327 @@
+// `hnn compare`: every (task, model, loss) of a study for N seeds, run through the sweep engine
+// (the same run folders, Dask driver, resume and lock as `hnn sweep`), then a table of ours beside
+// the peers' published numbers (apps/hnn/compare/compare_report.py, called by the driver at the
+// end). Which pairs run is decided by hnn itself: each is expanded and checked as `hnn sweep`
+// checks a run (tasks::validate), and a pair that fails is a "skipped: <reason>" row of the table.
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <fstream>
+#include <set>
+
+#include "apps/hnn/commands/commands.h"
+#include "apps/hnn/commands/validators.h"
+#include "apps/hnn/compare/peers.h"
+#include "apps/hnn/sweep/keys.h"
+#include "apps/hnn/sweep/launch.h"
+#include "tasks/data/data_files.h"
+#include "tasks/experiments/registry.h"
+#include "tasks/task.h"
+
+namespace hnn::app {
+
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+using nlohmann::ordered_json;
+
+/// --quick: steps of every run (a smoke run of the whole study).
+constexpr int kQuickSteps = 100;
+
+struct CompareOptions {
+  std::vector<std::string> tasks, models, losses;
+  int seeds = 3, steps = 0;
+  std::string out;
+  bool quick = false, list = false;
+  sweep::LaunchOptions launch;
+  std::string command;  // the command line, for the report
+};
+
+// Tasks x models x losses, crossed; in the default study also the protocol of a peer: sweep keys
+// of every run (`keys`) and of the rollout-loss runs (`rollout_keys`), the headline metric and
+// further metrics.json keys for the table.
+struct Group {
+  std::vector<std::string> tasks, models, losses;
+  ordered_json keys = ordered_json::object(), rollout_keys = ordered_json::object();
+  std::string headline;              // "": the peers file's for the task
+  std::vector<std::string> metrics;  // shown on every row of the group
+};
+
+Group crossed(std::vector<std::string> tasks, std::vector<std::string> models,
+              std::vector<std::string> losses) {
+  Group g;
+  g.tasks = std::move(tasks);
+  g.models = std::move(models);
+  g.losses = std::move(losses);
+  return g;
+}
+
+// The default study: the tasks where each family matters, each at its peer's protocol. Names this
+// hnn lacks become skipped rows saying so, not errors.
+std::vector<Group> default_study() {
+  // SRNN's three-body: the HNN paper's system sampled at dt = 1 (its 100 + 32 trajectories of 10
+  // points), trained through leapfrog on windows of 5 points, batch 32 (docs/families.md).
+  Group three_body = crossed({"three-body"}, {"baseline", "hnn"}, {"derivative", "rollout"});
+  three_body.keys["settings"] = {{"setup", "srnn"}};
+  three_body.rollout_keys = {
+      {"integrator", "leapfrog"}, {"horizon", 4}, {"batch", 32}, {"steps", 5000}};
+  three_body.headline = "stretch_position_error";
+  three_body.metrics = {"truth_leapfrog_position_error", "valid_prediction_time"};
+  // Where the rollout loss wins: the spring sampled every time unit, noisy (docs/families.md).
+  Group coarse_spring = crossed({"spring"}, {"baseline", "hnn"}, {"derivative", "rollout"});
+  coarse_spring.keys["settings"] = {{"sample_dt", 1.0}, {"t_end", 6}};
+  coarse_spring.rollout_keys = {{"integrator", "leapfrog"}, {"horizon", 1}};
+  coarse_spring.headline = "stretch_state_mse";
+  coarse_spring.metrics = {"truth_leapfrog_state_mse"};
+  // The D-HNN paper's real pendulum (their analysis notebook): the Lipson file through the data
+  // task, 80/20 in time, width 256, batch 128, 5000 steps at 5e-3; the energy MSE of
+  // H = 2.4 (1 - cos q) + p^2 along the held-out trajectory rolled out from its first state.
+  Group dhnn_real = crossed({"data"}, {"baseline", "hnn", "dhnn"}, {"derivative"});
+  dhnn_real.keys = {{"data", tasks::default_data_path("lipson/real_pend_h_1.txt")},
+                    {"hidden", {256, 256}},
+                    {"batch", 128},
+                    {"steps", 5000},
+                    {"lr", 5e-3},
+                    {"hamiltonian", "2.4*(1 - cos(o)) + v^2"},
+                    {"settings", {{"energy_t_end", 20}, {"rollouts", 15}}}};
+  dhnn_real.headline = "held_out_energy_mse";
+  dhnn_real.metrics = {"valid_prediction_time"};
+  return {crossed({"real-pendulum", "damped-spring"}, {"baseline", "hnn", "dhnn"}, {"derivative"}),
+          dhnn_real, crossed({"double-pendulum"}, {"baseline", "hnn", "lnn"}, {"derivative"}),
+          three_body, coarse_spring};
+}
+
+// One row of the table: a (task, model, loss) at its protocol's keys, and its runs, or why it
+// does not run.
+struct Row {
+  std::string task, model, loss;
+  ordered_json keys = ordered_json::object();
+  std::string headline;
+  std::vector<std::string> metrics;
+  std::string skipped;  // "": runs
+  std::vector<std::string> runs;
+};
+
+bool contains(const std::vector<std::string>& names, const std::string& name) {
+  return std::find(names.begin(), names.end(), name) != names.end();
+}
+
+void check_names(const std::vector<std::string>& given, const std::vector<std::string>& known,
+                 const char* option, const char* what) {
+  for (const std::string& name : given) {
+    if (!contains(known, name)) {
+      throw std::invalid_argument(fmt::format("compare: {}: unknown {} '{}' (known: {})", option,
+                                              what, name, fmt::join(known, ", ")));
+    }
+  }
+}
+
+// The study's groups: --tasks x --models x --loss, or the default study narrowed to the --models
+// and --loss given.
+std::vector<Group> study(const CompareOptions& o) {
+  if (!o.tasks.empty()) {
+    return {crossed(o.tasks, o.models.empty() ? tasks::model_names() : o.models,
+                    o.losses.empty() ? std::vector<std::string>{"derivative"} : o.losses)};
+  }
+  std::vector<Group> groups;
+  for (Group g : default_study()) {
+    const auto keep = [](std::vector<std::string>& names, const std::vector<std::string>& only) {
+      if (only.empty()) return;
+      std::erase_if(names, [&](const std::string& n) { return !contains(only, n); });
+    };
+    keep(g.models, o.models);
+    keep(g.losses, o.losses);
+    if (!g.models.empty() && !g.losses.empty()) groups.push_back(g);
+  }
+  if (groups.empty())
+    throw std::invalid_argument("compare: the default study has no runs of those --models/--loss");
+  return groups;
+}
+
+// The sweep spec of one row: its task, model and loss, and the seeds (and steps) of the study.
+ordered_json row_spec(const Row& row, const CompareOptions& o) {
+  ordered_json spec = ordered_json::object();
+  spec["task"] = {row.task};
+  spec["model"] = {row.model};
+  ordered_json seeds = ordered_json::array();
+  for (int s = 0; s < o.seeds; ++s) seeds.push_back(static_cast<unsigned long long>(s));
+  spec["seed"] = seeds;
+  for (const auto& [key, value] : row.keys.items()) spec[key] = ordered_json::array({value});
+  if (o.steps > 0) spec["steps"] = {o.steps};               // over the protocol's own
+  if (row.loss != "derivative") spec["loss"] = {row.loss};  // derivative: hnn train's default
+  return spec;
+}
+
+// "compare: run 'x/y/seed=0': why" or "compare: key 'loss': why" -> the why, as hnn said it.
+std::string reason_of(std::string message) {
+  const std::string prefix = "compare: ";
+  if (message.rfind(prefix, 0) == 0) message.erase(0, prefix.size());
+  if (message.rfind("run '", 0) == 0) {
+    if (const auto end = message.find("': "); end != std::string::npos) message.erase(0, end + 3);
+  }
+  return message;
+}
+
+// Expands every row through the sweep's checks; the runs of those that pass make one plan.
+sweep::SweepPlan expand_rows(std::vector<Row>& rows, const CompareOptions& o, const fs::path& out) {
+  const std::vector<std::string> known_tasks = tasks::task_names(),
+                                 known_models = tasks::model_names();
+  sweep::SweepPlan plan;
+  std::set<std::string> keys, names;
+  for (Row& row : rows) {
+    if (!contains(known_tasks, row.task)) {
+      row.skipped = fmt::format("this hnn has no task '{}' yet (its tasks: {})", row.task,
+                                fmt::join(known_tasks, ", "));
+      continue;
+    }
+    if (!contains(known_models, row.model)) {
+      row.skipped = fmt::format("this hnn has no model '{}' yet (its models: {})", row.model,
+                                fmt::join(known_models, ", "));
+      continue;
+    }
+    sweep::SweepPlan one;
+    try {
+      one = sweep::expand(row_spec(row, o), "compare", out);
+    } catch (const std::invalid_argument& e) {
+      row.skipped = reason_of(e.what());
+      continue;
+    }
+    for (sweep::SweepRun& r : one.runs) {
+      row.runs.push_back(r.name);
+      if (names.insert(r.name).second) plan.runs.push_back(std::move(r));
+    }
+    keys.insert(one.keys.begin(), one.keys.end());
+  }
+  for (const sweep::KeyInfo& k : sweep::key_table())
+    if (keys.count(std::string(k.name))) plan.keys.emplace_back(k.name);
+  return plan;
+}
+
+std::vector<Row> rows_of(const std::vector<Group>& groups) {
+  std::vector<Row> rows;
+  std::set<std::string> seen;
+  for (const Group& g : groups)
+    for (const std::string& t : g.tasks)
+      for (const std::string& m : g.models)
+        for (const std::string& l : g.losses) {
+          if (!seen.insert(t + "\n" + m + "\n" + l).second) continue;
+          Row row{t, m, l, g.keys, g.headline, g.metrics, "", {}};
+          if (l == "rollout") row.keys.update(g.rollout_keys);
+          rows.push_back(std::move(row));
+        }
+  return rows;
+}
+
+json rows_json(const std::vector<Row>& rows) {
+  json out = json::array();
+  for (const Row& r : rows) {
+    out.push_back({{"task", r.task},
+                   {"model", r.model},
+                   {"loss", r.loss},
+                   {"keys", json::parse(r.keys.dump())},
+                   {"headline", r.headline.empty() ? json(nullptr) : json(r.headline)},
+                   {"metrics", r.metrics},
+                   {"runs", r.runs},
+                   {"skipped", r.skipped.empty() ? json(nullptr) : json(r.skipped)}});
+  }
+  return out;
+}
+
+json compare_section(const std::vector<Row>& rows, const CompareOptions& o) {
+  const fs::path file = peers_path();
+  json peers_doc = read_peers(file);
+  std::vector<std::string> own_settings;  // tasks with rows at their own settings: Table 1's
+  for (const Row& row : rows) {
+    if (row.keys.empty() && !contains(own_settings, row.task)) own_settings.push_back(row.task);
+  }
+  json peers = table1_peers(own_settings);
+  for (const json& p : peers_doc["peers"]) peers.push_back(p);
+  return {{"command", o.command},
+          {"seeds", o.seeds},
+          {"steps", o.steps > 0 ? json(o.steps) : json("each task's default")},
+          {"peers_file", fs::absolute(file).lexically_normal().string()},
+          {"headline", peers_doc.value("headline", json::object())},
+          {"report_metrics", peers_doc.value("report_metrics", json::array({"test_loss"}))},
+          {"hnn_tasks", tasks::task_names()},
+          {"rows", rows_json(rows)},
+          {"peers", peers}};
+}
+
+void list_rows(const std::vector<Row>& rows) {
+  for (const Row& r : rows) {
+    const std::string keys = r.keys.empty() ? "" : " " + r.keys.dump();
+    if (r.skipped.empty())
+      fmt::print("{} {} {}{}: {} runs\n", r.task, r.model, r.loss, keys, r.runs.size());
+    else
+      fmt::print("{} {} {}{}: skipped: {}\n", r.task, r.model, r.loss, keys, r.skipped);
+  }
+}
+
+void run_compare(CompareOptions o) {
+  check_names(o.tasks, tasks::task_names(), "--tasks", "task");
+  check_names(o.models, tasks::model_names(), "--models", "model");
+  check_names(o.losses, loss_names(), "--loss", "loss");
+  sweep::check_scheduler(o.launch.scheduler);
+  if (o.quick && o.steps == 0) o.steps = kQuickSteps;
+  const fs::path out = fs::absolute(o.out).lexically_normal();
+  std::vector<Row> rows = rows_of(study(o));
+  if (o.steps > 0) {
+    for (Row& row : rows) row.keys.erase("steps");  // --steps is every run's
+  }
+  const sweep::SweepPlan plan = expand_rows(rows, o, out);
+  const json section = compare_section(rows, o);  // the peers file is checked before any run
+  if (o.list) {
+    list_rows(rows);
+    return sweep::list_runs(plan, o.launch, out);
+  }
+  const fs::path report =
+      sweep::shared_file("HNN_COMPARE_REPORT", "compare_report.py", HNN_COMPARE_REPORT_SOURCE);
+  sweep::launch(plan, o.launch, out, o.command, "run",
+                {{"compare", section}, {"report_module", report.string()}});
+}
+
+std::string command_line(int argc, char** argv) {
+  std::string line = "hnn";
+  for (int i = 1; i < argc; ++i) line += " " + sweep::shell_quote(argv[i]);
+  return line;
+}
+
+}  // namespace
+
+void add_compare_command(CLI::App& app, int argc, char** argv) {
+  auto* cmd = app.add_subcommand(
+      "compare",
+      "Train every model family on the study's tasks for N seeds (through hnn sweep's engine) "
+      "and table ours beside the peers' published numbers; see docs/compare.md");
+  auto o = std::make_shared<CompareOptions>();
+  o->command = command_line(argc, argv);
+  cmd->add_option("--tasks", o->tasks,
+                  "Comma-separated tasks (default: the study of docs/compare.md)")
+      ->delimiter(',');
+  cmd->add_option("--models", o->models,
+                  "Comma-separated model families (default: every one hnn has)")
+      ->delimiter(',');
+  cmd->add_option("--loss", o->losses, "Comma-separated losses: derivative, rollout")
+      ->delimiter(',');
+  cmd->add_option("--seeds", o->seeds, "Seeds per task, model and loss (0..N-1)")
+      ->check(integer_in(1, 1000))
+      ->capture_default_str();
+  cmd->add_option("--steps", o->steps, "Training steps of every run (default: each task's)")
+      ->check(positive_integer());
+  cmd->add_flag("--quick", o->quick,
+                fmt::format("A smoke run: {} steps a run unless --steps", kQuickSteps));
+  cmd->add_option("--out", o->out, "Folder: runs/, results.csv, compare.md/.json, the chart")
+      ->required();
+  sweep::add_launch_options(*cmd, o->launch);
+  cmd->add_flag("--list", o->list,
+                "Print each task, model and loss (its runs, or why it is skipped) and each run's "
+                "hnn train command; run nothing");
+  cmd->callback([o] { run_compare(*o); });
+}
+
+}  // namespace hnn::app

@@ -1,0 +1,333 @@
+// The `data` task: a user's own trajectories, measured or simulated (CSV, .npy, .npz or the
+// Schmidt & Lipson text format), learned in standardised units and reported in the file's.
+// Without a known H it is judged by rolling out from each held-out stretch's first state; with
+// one (--hamiltonian) also by the energy MSE of the other tasks.
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+
+#include "physics/expression_system.h"
+#include "physics/integrator.h"
+#include "tasks/data/units.h"
+#include "tasks/evaluate/field_evaluation.h"
+#include "tasks/evaluate/held_out.h"
+#include "tasks/experiments/data_config.h"
+#include "tasks/experiments/registry.h"
+#include "tasks/field/field_model_run.h"
+#include "tasks/report/json_values.h"
+#include "tasks/train/rollout_objective.h"
+
+namespace hnn::tasks {
+
+namespace {
+
+using nlohmann::json;
+
+// The H of --hamiltonian over the state's column names.
+std::unique_ptr<physics::ExpressionSystem> make_truth(const std::string& expression,
+                                                      const MeasuredData& m) {
+  if (expression.empty()) return nullptr;
+  const auto n = std::ptrdiff_t(m.coordinates);
+  std::vector<std::string> q(m.state_names.begin(), m.state_names.begin() + n),
+      p(m.state_names.begin() + n, m.state_names.end());
+  try {
+    return std::make_unique<physics::ExpressionSystem>(expression, q, p);
+  } catch (const std::invalid_argument& e) {
+    throw Error(fmt::format("--hamiltonian: {} (the state's names: {})", e.what(),
+                            fmt::join(m.state_names, ", ")));
+  }
+}
+
+// A model's field and H in the model's units, seen in the file's.
+LearnedField in_file_units(const LearnedField& model, const Units& u) {
+  LearnedField file{.field = [model, u](double t, const Batch& x, Batch& dxdt) {
+    Batch dzdt;
+    model.field(t / u.time, u.to_model(x), dzdt);
+    dxdt = u.rate_to_file(dzdt);
+  }};
+  if (model.hamiltonian) {
+    file.hamiltonian = [model, u](const Batch& x) -> Eigen::VectorXd {
+      return model.hamiltonian(u.to_model(x)) * u.energy_to_file();
+    };
+  }
+  return file;
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return NAN;
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
+// n rows evenly spread over x.
+Batch spread_rows(const Batch& x, int n) {
+  n = int(std::min<Eigen::Index>(n, x.rows()));
+  Batch out(n, x.cols());
+  for (int i = 0; i < n; ++i) out.row(i) = x.row(Eigen::Index(i) * x.rows() / n);
+  return out;
+}
+
+// What a data run is built from, before the model: the file's trajectories, the units.
+struct Prepared {
+  DataConfig config{};
+  MeasuredData measured{};
+  Units units{};
+  std::unique_ptr<physics::ExpressionSystem> truth{};
+};
+
+Prepared prepare(const RunSettings& s) {
+  HNN_TASKS_CHECK(!s.data_file.empty(),
+                  "the data task needs a file: hnn train data --data FILE (CSV, .npy, .npz or "
+                  "Schmidt & Lipson text)");
+  Prepared p{.config = data_config(s.task_settings)};
+  p.measured = load_measured_data(s.data_file, p.config.measured);
+  HNN_TASKS_CHECK(p.measured.data.train_x.rows() >= 2 && p.measured.data.test_x.rows() >= 1,
+                  "{}: {} training and {} test rows: too few to train and test", p.measured.source,
+                  p.measured.data.train_x.rows(), p.measured.data.test_x.rows());
+  p.units = p.config.standardize
+                ? fit_units(p.measured.data, p.measured.coordinates, p.measured.state_names)
+                : identity_units(p.measured.data.train_x.cols());
+  p.truth = make_truth(p.config.hamiltonian, p.measured);
+  return p;
+}
+
+class DataRun : public FieldModelRun {
+ public:
+  DataRun(RunSettings settings, Prepared p)
+      : FieldModelRun(std::move(settings), p.units.to_model(p.measured.data)), p_(std::move(p)) {
+    const RolloutLossConfig& loss = p_.config.loss;
+    if (!loss.rollout) return;
+    // Checked here, before a run folder exists.
+    train_windows_ = rollout_windows(stretches(p_.measured.train_stretches), loss.horizon);
+    const std::vector<Stretch> test = stretches(p_.measured.held_out);
+    const bool any_test = std::any_of(test.begin(), test.end(),
+                                      [&](const Stretch& t) { return t.x.rows() > loss.horizon; });
+    if (any_test) test_windows_ = rollout_windows(test, loss.horizon);
+    substeps_ = rollout_substeps(train_windows_, loss.dt / p_.units.time);
+    HNN_TASKS_CHECK(s_.train.batch_size <= train_windows_.count(),
+                    "--batch {} is larger than the {} rollout windows of the training set",
+                    s_.train.batch_size, train_windows_.count());
+  }
+
+  // The rollout loss trains from the states alone; the derivative loss as every field task.
+  TrainResult train(const LoopOptions& loop) override {
+    if (!p_.config.loss.rollout) return FieldModelRun::train(loop);
+    return with_scalar(s_.dtype, [&]<typename T>() {
+      std::unique_ptr<nn::DynamicsModel<T>> model = fresh_model<T>();
+      RolloutObjective<T> objective(
+          *model, train_windows_, test_windows_, s_.train.batch_size,
+          {.lr = s_.train.learning_rate, .weight_decay = s_.train.weight_decay}, s_.seed,
+          p_.config.loss.integrator, substeps_);
+      LoopOptions o = loop;
+      o.steps = s_.train.steps;
+      o.lr_schedule = s_.train.lr_schedule;
+      o.record_every = s_.train.record_every;
+      const TrainResult result = tasks::train(objective, o);
+      keep(std::move(model));
+      return result;
+    });
+  }
+
+  json evaluate(const RunFolder* folder) const override {
+    const LearnedField model = learned_field(dynamics());
+    const LearnedField file = in_file_units(model, p_.units);
+    const Dataset& d = p_.measured.data;
+    const nn::MeanStderr train = loss_stats(file.field, d.train_x, d.train_dxdt);
+    const nn::MeanStderr test = loss_stats(file.field, d.test_x, d.test_dxdt);
+    json m = {{"train_loss", number(train.mean)},
+              {"train_loss_se", number(train.std_error)},
+              {"test_loss", number(test.mean)},
+              {"test_loss_se", number(test.std_error)},
+              {"train_r2", number(r_squared(train.mean, d.train_dxdt))},
+              {"test_r2", number(r_squared(test.mean, d.test_dxdt))},
+              {"n_train", d.train_x.rows()},
+              {"n_test", d.test_x.rows()}};
+    const HeldOutEvaluation held = evaluate_held_out(
+        model, p_.units, p_.measured.held_out, p_.measured.coordinates, data_.train_x,
+        {.threshold = p_.config.threshold, .truth = p_.truth.get()});
+    m.update(held.metrics);
+    if (dynamics().config().field == nn::FieldType::kBoth) {
+      m["dissipation_share"] = number(dissipation_share(
+          dynamics(), data_.test_x, [&](const Batch& f) { return p_.units.rate_to_file(f); }));
+    }
+    m.update(energy_metrics(file));
+    m["training"] = p_.config.loss.to_json();
+    m["units"] = p_.units.to_json();
+    m["state_names"] = p_.measured.state_names;
+    m["data"] = describe(p_.measured);
+    if (folder) folder->write_text("rollout.csv", held_out_csv(held));
+    return m;
+  }
+
+  // `hnn rollout`: the measured held-out stretches ("data") and the model's paths from their
+  // first states with the requested integrator, in the file's units.
+  std::string rollout_csv(const RolloutRequest& r) const override {
+    const Units& u = p_.units;
+    const auto integrator = physics::make_integrator(
+        r.integrator, {.dt = r.dt / u.time, .rtol = r.rtol, .atol = r.rtol * 1e-3});
+    const LearnedField model = learned_field(dynamics());
+    const std::vector<double> t =
+        physics::linspace(0.0, r.t_end.value_or(rollout_span() * u.time), r.points);
+    std::vector<double> t_model(t.size());
+    std::transform(t.begin(), t.end(), t_model.begin(), [&](double v) { return v / u.time; });
+    std::string csv = "source,traj,t";
+    for (const std::string& name : p_.measured.state_names) csv += "," + name;
+    csv += ",energy,learned_h\n";
+    const auto& held = p_.measured.held_out;
+    for (std::size_t i = 0; i < held.size() && int(i) < r.trajectories; ++i) {
+      append_rows(csv, "data", i, (held[i].t.array() - held[i].t(0)).matrix(), held[i].x,
+                  std::nullopt);
+      const Batch z =
+          integrator->integrate(model.field, u.to_model(Batch(held[i].x.topRows(1))), t_model)
+              .path(0);
+      std::optional<Eigen::VectorXd> h;
+      if (model.hamiltonian) h = model.hamiltonian(z) * u.energy_to_file();
+      append_rows(csv, nn::to_string(s_.model), i,
+                  Eigen::Map<const Eigen::VectorXd>(t.data(), Eigen::Index(t.size())), u.to_file(z),
+                  h);
+    }
+    return csv;
+  }
+
+  // The units folded into the weights: the first layer takes x instead of z = (x - mean) / scale
+  // and the last gives H in the file's units (an HNN) or dx/dt (a baseline). Exact: an affine map
+  // into a linear layer is a linear layer.
+  std::unique_ptr<nn::DynamicsModel<double>> model_in_data_units() const override {
+    HNN_TASKS_CHECK(dynamics().config().field != nn::FieldType::kBoth,
+                    "a dhnn trained on standardised data has no single D in the file's units "
+                    "(its dissipation scales per column); only an hnn or a baseline converts");
+    std::unique_ptr<nn::DynamicsModel<double>> m = nn::cast_model<double>(dynamics());
+    const Units& u = p_.units;
+    const std::size_t layers = m->config().hidden.size() + 1;
+    const Eigen::RowVectorXd output_scale =
+        nn::learns_scalars(m->config().model)
+            ? Eigen::RowVectorXd::Constant(m->mlp().config().widths.back(), u.energy_to_file())
+            : Eigen::RowVectorXd(u.scale / u.time);
+    nn::Matrix<double> first_weight;
+    m->visit_parameters([&](const std::string& name, ad::Var<double>& p) {
+      nn::Matrix<double>& v = p.mutable_value();
+      if (name == "mlp.layers.0.weight") {
+        first_weight = v;  // the bias below needs it unscaled
+        v = u.scale.cwiseInverse().asDiagonal() * v;
+      }
+      if (name == "mlp.layers.0.bias") v -= u.mean.cwiseQuotient(u.scale) * first_weight;
+      const std::string last = fmt::format("mlp.layers.{}.", layers - 1);
+      if (name.starts_with(last)) v = v * output_scale.asDiagonal();
+    });
+    return m;
+  }
+
+  // Test states spread over the held-out rows, in the model's units.
+  Batch rollout_states(int count) const override { return spread_rows(data_.test_x, count); }
+
+  // The held-out stretches' median duration, in the model's time unit.
+  double rollout_span() const override { return held_out_duration() / p_.units.time; }
+
+ private:
+  double held_out_duration() const {
+    std::vector<double> spans;
+    for (const HeldOut& h : p_.measured.held_out) spans.push_back(h.t(h.t.size() - 1) - h.t(0));
+    return median(spans);
+  }
+
+  // With a known H, the energy MSE of the other tasks: the true and the learned field from test
+  // states over the held-out duration (or energy_t_end).
+  json energy_metrics(const LearnedField& file) const {
+    if (!p_.truth) {
+      return {{"energy_mse", nullptr},
+              {"energy_mse_se", nullptr},
+              {"energy_note", "no known Hamiltonian: give one with --hamiltonian EXPR"},
+              {"relative_error_floor_note",
+               "no known Hamiltonian to perturb (--hamiltonian EXPR gives "
+               "truth_rollout_relative_error_floor)"}};
+    }
+    const double t_end = p_.config.t_end > 0 ? p_.config.t_end : held_out_duration();
+    const Batch x0 = spread_rows(p_.measured.data.test_x, p_.config.rollouts);
+    // The floor's perturbation is 1e-4 in the model's (standardised) units.
+    const RolloutConfig config{
+        .trajectories = int(x0.rows()),
+        .t_end = t_end,
+        .perturbation_scale = {p_.units.scale.data(),
+                               p_.units.scale.data() + p_.units.scale.size()},
+        .seed = s_.seed + 2};
+    const Rollouts r = make_rollouts(*p_.truth, file, x0, config);
+    json m = rollout_metrics(r, p_.config.threshold);
+    // The held-out stretches' valid prediction time and state error keep their names; these
+    // are the rollouts against the known H.
+    json out = {{"energy_mse", m["energy_mse"]},
+                {"energy_mse_se", m["energy_mse_se"]},
+                {"energy_mse_count", m["energy_mse_count"]},
+                {"n_rollouts", m["n_rollouts"]},
+                {"rollouts", m["rollouts"]},
+                {"rollout_failures", r.failures},
+                {"energy_t_end", t_end},
+                {"hamiltonian", p_.config.hamiltonian}};
+    for (const char* key :
+         {"state_mse", "relative_error_geomean", "relative_error_floor", "valid_prediction_time"}) {
+      for (const char* suffix : {"", "_se", "_count"})
+        out[std::string("truth_rollout_") + key + suffix] = m[std::string(key) + suffix];
+    }
+    if (x0.rows() < p_.config.rollouts) {
+      out["rollouts_note"] = fmt::format("{} rollouts, not {}: the test set has {} states",
+                                         x0.rows(), p_.config.rollouts, x0.rows());
+    }
+    return out;
+  }
+
+  // Rows source,traj,t,x..,energy (with a known H),learned_h (with h).
+  void append_rows(std::string& csv, std::string_view source, std::size_t traj,
+                   const Eigen::VectorXd& t, const Batch& x,
+                   const std::optional<Eigen::VectorXd>& h) const {
+    const Eigen::VectorXd energy =
+        p_.truth ? p_.truth->energy_batch(x) : Eigen::VectorXd::Constant(x.rows(), NAN);
+    for (Eigen::Index k = 0; k < x.rows(); ++k) {
+      csv += fmt::format("{},{},{:.12g}", source, traj, t(k));
+      for (Eigen::Index c = 0; c < x.cols(); ++c) csv += fmt::format(",{:.12g}", x(k, c));
+      csv += std::isfinite(energy(k)) ? fmt::format(",{:.12g},", energy(k)) : std::string(",,");
+      csv += h ? fmt::format("{:.12g}\n", (*h)(k)) : std::string("\n");
+    }
+  }
+
+  // Stretches in the model's units (time from the file's origin, in the model's unit).
+  std::vector<Stretch> stretches(const std::vector<HeldOut>& parts) const {
+    std::vector<Stretch> out;
+    for (const HeldOut& h : parts) out.push_back({h.t / p_.units.time, p_.units.to_model(h.x)});
+    return out;
+  }
+
+  Prepared p_;
+  RolloutWindows train_windows_{}, test_windows_{};
+  int substeps_ = 1;
+};
+
+class DataTask : public Task {
+ public:
+  std::string name() const override { return "data"; }
+  std::string summary() const override {
+    return "your own trajectories: --data FILE (CSV, .npy, .npz, Schmidt & Lipson text)";
+  }
+  TrainConfig train_config() const override { return {}; }
+  PaperRow paper(nn::ModelKind) const override {
+    return {{NAN, NAN}, {NAN, NAN}, {NAN, NAN}};  // not one of the paper's tasks
+  }
+  bool reads_data_file() const override { return true; }
+  void check_task_settings(const json& settings) const override {
+    for (const auto& [key, value] : settings.items()) {
+      HNN_TASKS_CHECK(std::find(data_setting_names().begin(), data_setting_names().end(), key) !=
+                          data_setting_names().end(),
+                      "the data task has no setting '{}' (known: {})", key,
+                      fmt::join(data_setting_names(), ", "));
+    }
+    data_config(settings);
+  }
+  std::unique_ptr<TaskRun> open(const RunSettings& settings) const override {
+    return std::make_unique<DataRun>(settings, prepare(settings));
+  }
+};
+
+}  // namespace
+
+std::unique_ptr<Task> make_data_task() { return std::make_unique<DataTask>(); }
+
+}  // namespace hnn::tasks

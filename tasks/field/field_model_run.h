@@ -1,0 +1,92 @@
+#pragma once
+// The part of a run that every task learning a field dx/dt = f(x) from a Dataset shares: a fresh
+// model from the run's seed, training with FieldObjective, saving and loading. What a task
+// evaluates and rolls out is its own (FieldRun in field_task.cpp, DataRun in
+// tasks/experiments/data_task.cpp).
+
+#include "nn/checkpoint.h"
+#include "nn/hnn.h"
+#include "tasks/data/dataset.h"
+#include "tasks/task.h"
+#include "tasks/trained_model.h"
+
+namespace hnn::tasks {
+
+/// Trains `model` on `data` with FieldObjective and the training loop: steps, batch size,
+/// learning rate, weight decay and record interval from `config`, the rest (checkpoints, resume,
+/// stop, progress) from `loop`. Minibatches are drawn from a generator seeded with `seed`.
+template <typename T>
+TrainResult train_model(nn::DynamicsModel<T>& model, const Dataset& data, const TrainConfig& config,
+                        std::uint64_t seed, LoopOptions loop = {});
+
+/// How the models see their inputs (angle coordinates, input scales), as the task says.
+struct ModelInput {
+  Eigen::Index angles = 0;
+  std::vector<double> input_scale{};
+};
+
+class FieldModelRun : public TaskRun {
+ public:
+  TrainResult train(const LoopOptions& loop) override {
+    return with_scalar(s_.dtype, [&]<typename T>() {
+      std::unique_ptr<nn::DynamicsModel<T>> model = fresh_model<T>();
+      const TrainResult result = train_model(*model, data_, s_.train, s_.seed, loop);
+      keep(std::move(model));
+      return result;
+    });
+  }
+
+  void save(const std::filesystem::path& params) const override { model_.save(params); }
+
+  void load(const std::filesystem::path& params) override {
+    with_scalar(s_.dtype, [&]<typename T>() {
+      std::unique_ptr<nn::DynamicsModel<T>> model = fresh_model<T>();
+      nn::load_parameters(params, *model);
+      keep(std::move(model));
+    });
+  }
+
+  const nn::DynamicsModel<double>& dynamics() const override { return model_.in_double(); }
+
+ protected:
+  /// Checks the batch size against the data before a run folder exists: a bad one leaves
+  /// nothing behind.
+  FieldModelRun(RunSettings settings, Dataset data, ModelInput input = {})
+      : s_(std::move(settings)), data_(std::move(data)), input_(std::move(input)) {
+    HNN_TASKS_CHECK(s_.train.batch_size <= data_.train_x.rows(),
+                    "--batch {} is larger than the training set ({} rows)", s_.train.batch_size,
+                    data_.train_x.rows());
+  }
+
+  RunSettings s_;
+  Dataset data_;  ///< what the model trains on, in its own units
+  ModelInput input_;
+
+  template <typename T>
+  std::unique_ptr<nn::DynamicsModel<T>> fresh_model() const {
+    nn::DynamicsConfig config{.model = s_.model,
+                              .dim = data_.train_x.cols(),
+                              .angles = input_.angles,
+                              .input_scale = input_.input_scale};
+    if (s_.model == nn::ModelKind::kDhnn) config.field = nn::FieldType::kBoth;
+    config.hidden.assign(s_.train.hidden.begin(), s_.train.hidden.end());
+    try {
+      nn::validate(config);
+    } catch (const std::invalid_argument& e) {
+      throw Error(fmt::format("task '{}': {}", s_.task, e.what()));
+    }
+    std::mt19937_64 rng(s_.seed);
+    return nn::make_model<T>(config, rng);
+  }
+
+  template <typename T>
+  void keep(std::unique_ptr<nn::DynamicsModel<T>> model) {
+    auto in_double = nn::cast_model<double>(*model);
+    model_.keep(std::move(model), std::move(in_double));
+  }
+
+ private:
+  TrainedModel<nn::DynamicsModel> model_;
+};
+
+}  // namespace hnn::tasks

@@ -1,0 +1,320 @@
+// The run of a field task: train a dynamics model on the task's dataset (with FieldObjective on
+// dx/dt targets, or through an integrator with RolloutObjective), evaluate it against the true
+// system, save and load it, roll it out.
+
+#include "tasks/field/field_task.h"
+
+#include <fmt/ranges.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "autodiff/tape.h"
+#include "physics/integrator.h"
+#include "tasks/evaluate/field_evaluation.h"
+#include "tasks/field/field_model_run.h"
+#include "tasks/field/stretch_errors.h"
+#include "tasks/report/json_values.h"
+
+namespace hnn::tasks {
+
+namespace {
+
+using nlohmann::json;
+
+// The held-out error along stretches looks at this many test stretches at most.
+constexpr std::size_t kMaxStretches = 200;
+
+class FieldRun : public FieldModelRun {
+ public:
+  FieldRun(const FieldTask& task, RunSettings settings)
+      : FieldModelRun(settings, task.build_dataset(settings),
+                      {.angles = task.angle_coordinates(), .input_scale = task.input_scale()}),
+        task_(task),
+        loss_(rollout_loss_config(s_.task_settings, task.name())) {
+    check_rollouts();
+    stretches_ = task_.stretches(s_, data_);
+    if (!loss_.rollout) return;
+    // Checked here, before a run folder exists.
+    HNN_TASKS_CHECK(stretches_.has_value(),
+                    "{}: the rollout loss needs trajectories, and this task's data are states "
+                    "without them (use --loss derivative)",
+                    task_.name());
+    train_windows_ = rollout_windows(stretches_->train, loss_.horizon);
+    const bool any_test = std::any_of(stretches_->test.begin(), stretches_->test.end(),
+                                      [&](const Stretch& t) { return t.x.rows() > loss_.horizon; });
+    if (any_test) test_windows_ = rollout_windows(stretches_->test, loss_.horizon);
+    substeps_ = rollout_substeps(train_windows_, loss_.dt);
+    HNN_TASKS_CHECK(s_.train.batch_size <= train_windows_.count(),
+                    "--batch {} is larger than the {} rollout windows of the training set",
+                    s_.train.batch_size, train_windows_.count());
+  }
+
+  TrainResult train(const LoopOptions& loop) override {
+    if (!loss_.rollout) return FieldModelRun::train(loop);
+    return with_scalar(s_.dtype, [&]<typename T>() {
+      std::unique_ptr<nn::DynamicsModel<T>> model = fresh_model<T>();
+      RolloutObjective<T> objective(
+          *model, train_windows_, test_windows_, s_.train.batch_size,
+          {.lr = s_.train.learning_rate, .weight_decay = s_.train.weight_decay}, s_.seed,
+          loss_.integrator, substeps_);
+      LoopOptions o = loop;
+      o.steps = s_.train.steps;
+      o.lr_schedule = s_.train.lr_schedule;
+      o.record_every = s_.train.record_every;
+      const TrainResult result = tasks::train(objective, o);
+      keep(std::move(model));
+      return result;
+    });
+  }
+
+  nlohmann::json evaluate(const RunFolder* folder) const override {
+    const auto start = std::chrono::steady_clock::now();
+    const RolloutConfig config = evaluation_rollouts();
+    FieldEvaluation e =
+        task_.has_truth()
+            ? evaluate_field_model(task_.truth(), dynamics(), data_,
+                                   rollout_states(config.trajectories), config)
+            : evaluate_field_model(
+                  dynamics(), data_,
+                  follow_measured(measured_paths(config), learned_field(dynamics()), config));
+    if (config.trajectories < asked_rollouts_) {
+      e.metrics["rollouts_note"] =
+          fmt::format("{} rollouts, not {}: the data have {} distinct initial states",
+                      config.trajectories, asked_rollouts_, config.trajectories);
+    }
+    task_.add_metrics(e.rollouts, e.metrics);
+    e.metrics["eval_seconds"] =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (folder) folder->write_text("rollout.csv", tasks::rollout_csv(e.rollouts));
+    json m = e.metrics;
+    m["training"] = loss_.to_json();
+    if (stretches_ && !stretches_->test.empty()) m.update(held_out_stretches());
+    return m;
+  }
+
+  std::string rollout_csv(const RolloutRequest& r) const override {
+    const auto integrator =
+        physics::make_integrator(r.integrator, {.dt = r.dt, .rtol = r.rtol, .atol = r.rtol * 1e-3});
+    if (!task_.has_truth()) return measured_csv(r, *integrator);
+    return rollout_paths_csv(task_.truth(), dynamics(), nn::to_string(s_.model),
+                             rollout_states(r.trajectories), *integrator,
+                             physics::linspace(0.0, r.t_end.value_or(rollout_span()), r.points));
+  }
+
+  // The evaluation's states: a generator independent of the training data's draws. Without a
+  // truth, the first states of the measured paths.
+  physics::Batch rollout_states(int count) const override {
+    if (!task_.has_truth()) {
+      const std::vector<Eigen::MatrixXd> paths =
+          task_.measured_paths(s_, count, task_.rollout_config(s_.task_settings));
+      Batch x0(Eigen::Index(paths.size()), data_.test_x.cols());
+      for (std::size_t i = 0; i < paths.size(); ++i) x0.row(Eigen::Index(i)) = paths[i].row(0);
+      return x0;
+    }
+    std::mt19937_64 rng(s_.seed + 1);
+    physics::Batch x0 = task_.rollout_states(data_, count, rng);
+    x0.conservativeResize(std::min<Eigen::Index>(x0.rows(), count), Eigen::NoChange);
+    return x0;
+  }
+
+  double rollout_span() const override { return task_.rollout_config(s_.task_settings).t_end; }
+
+ private:
+  // The run's rollouts: the task's with its settings, as many as the data can start (checked
+  // against an explicit "rollouts" in the constructor), the floor's draws from the run's seed.
+  RolloutConfig evaluation_rollouts() const {
+    RolloutConfig config = task_.rollout_config(s_.task_settings);
+    config.trajectories = std::min(config.trajectories, available_rollouts_);
+    config.seed = s_.seed + 2;
+    return config;
+  }
+
+  std::vector<Eigen::MatrixXd> measured_paths(const RolloutConfig& config) const {
+    return task_.measured_paths(s_, config.trajectories, config);
+  }
+
+  // How many rollouts the run's data can start, found before a run folder exists: a "rollouts"
+  // setting above it is an error naming both; the default is cut to it (and metrics say so).
+  void check_rollouts() {
+    const RolloutConfig config = task_.rollout_config(s_.task_settings);
+    asked_rollouts_ = config.trajectories;
+    available_rollouts_ = int(rollout_states(config.trajectories).rows());
+    HNN_TASKS_CHECK(available_rollouts_ > 0, "{}: no state to start a rollout from", task_.name());
+    HNN_TASKS_CHECK(
+        !s_.task_settings.contains("rollouts") || available_rollouts_ >= config.trajectories,
+        "{}: rollouts {} is more than the {} distinct initial states its data have", task_.name(),
+        config.trajectories, available_rollouts_);
+  }
+
+  // `hnn rollout` without a truth: the measured paths ("measured", missing samples left out) and
+  // the model's from their first states with the requested integrator.
+  std::string measured_csv(const RolloutRequest& r, const physics::Integrator& integrator) const {
+    RolloutConfig config = task_.rollout_config(s_.task_settings);
+    config.trajectories = std::min(r.trajectories, available_rollouts_);
+    const std::vector<Eigen::MatrixXd> paths = measured_paths(config);
+    const std::vector<double> t = physics::linspace(0.0, config.t_end, config.points);
+    const std::vector<double> model_t =
+        physics::linspace(0.0, r.t_end.value_or(config.t_end), r.points);
+    std::string csv = "source,traj,t";
+    for (Eigen::Index c = 0; c < data_.test_x.cols(); ++c) csv += fmt::format(",x_{}", c);
+    csv += ",energy,learned_h\n";
+    const auto rows = [&](std::string_view source, std::size_t traj, const Eigen::MatrixXd& x,
+                          const std::vector<double>& times) {
+      for (Eigen::Index k = 0; k < x.rows(); ++k) {
+        if (!x.row(k).allFinite()) continue;
+        csv += fmt::format("{},{},{:.9g}", source, traj, times[std::size_t(k)]);
+        for (Eigen::Index c = 0; c < x.cols(); ++c) csv += fmt::format(",{:.12g}", x(k, c));
+        csv += ",,\n";
+      }
+    };
+    const physics::VectorField field = learned_field(dynamics()).field;
+    for (std::size_t i = 0; i < paths.size(); ++i) {
+      rows("measured", i, paths[i], t);
+      rows(nn::to_string(s_.model), i,
+           integrator.integrate(field, Batch(paths[i].topRows(1)), model_t).path(0), model_t);
+    }
+    return csv;
+  }
+
+  // The model (and the truth by leapfrog, one step per interval) from the first state of each
+  // test stretch along its times. A rollout-trained model steps as it trained (its integrator
+  // and sub-steps: the discrete map it learned); a derivative-trained one is integrated
+  // accurately (dopri5), the best use of a learned field.
+  json held_out_stretches() const {
+    std::vector<Stretch> test(stretches_->test.begin(),
+                              stretches_->test.begin() +
+                                  std::ptrdiff_t(std::min(kMaxStretches, stretches_->test.size())));
+    const int per_body = task_.coordinates_per_body();
+    int failures = 0, train_failures = 0, truth_failures = 0;
+    json m = stretch_errors("stretch_", test, predict_paths(test, model_predictor(), failures),
+                            per_body);
+    m["stretch_failures"] = failures;
+    // The same on training stretches: the gap to the test figure is what generalisation costs.
+    std::vector<Stretch> train(
+        stretches_->train.begin(),
+        stretches_->train.begin() +
+            std::ptrdiff_t(std::min(kMaxStretches, stretches_->train.size())));
+    const json fit = stretch_errors(
+        "train_stretch_", train, predict_paths(train, model_predictor(), train_failures), per_body);
+    m["train_stretch_position_error"] = fit["train_stretch_position_error"];
+    m["train_stretch_state_mse"] = fit["train_stretch_state_mse"];
+    m["train_stretch_failures"] = train_failures;
+    m["stretch_predictor"] = loss_.rollout ? fmt::format("{}, {} step(s) per interval",
+                                                         to_string(loss_.integrator), substeps_)
+                                           : std::string("dopri5 (rtol 1e-9)");
+    m["n_stretches"] = test.size();
+    if (!task_.has_truth()) return m;
+    const Predictor leapfrog = [&](const Batch& x0, const Eigen::VectorXd& t) {
+      const double interval = t.size() > 1 ? t(1) - t(0) : 1.0;
+      const auto integrator = physics::make_integrator("leapfrog", {.dt = interval * (1 + 1e-9)});
+      return integrator->integrate(task_.truth().field(), x0, {t.data(), t.data() + t.size()})
+          .states;
+    };
+    const json truth = stretch_errors("truth_leapfrog_", test,
+                                      predict_paths(test, leapfrog, truth_failures), per_body);
+    m["truth_leapfrog_position_error"] = truth["truth_leapfrog_position_error"];
+    m["truth_leapfrog_position_error_std"] = truth["truth_leapfrog_position_error_std"];
+    m["truth_leapfrog_state_mse"] = truth["truth_leapfrog_state_mse"];
+    m["truth_leapfrog_failures"] = truth_failures;
+    return m;
+  }
+
+  Predictor model_predictor() const {
+    if (!loss_.rollout) {
+      return [this](const Batch& x0, const Eigen::VectorXd& t) {
+        // max_steps as the energy rollouts': a stiff learned field fails here, not hangs.
+        const auto integrator =
+            physics::make_integrator("dopri5", {.rtol = 1e-9, .atol = 1e-12, .max_steps = 100'000});
+        return integrator
+            ->integrate(learned_field(dynamics()).field, x0, {t.data(), t.data() + t.size()})
+            .states;
+      };
+    }
+    return [this](const Batch& x0, const Eigen::VectorXd& t) {
+      ad::TapeScope scope;
+      ad::NoGradGuard values_only;
+      std::vector<Batch> states{x0};
+      ad::Var<double> x = ad::Var<double>::constant(x0);
+      for (Eigen::Index k = 1; k < t.size(); ++k) {
+        const ad::Var<double> h =
+            ad::Var<double>::constant(Batch::Constant(x0.rows(), 1, (t(k) - t(k - 1)) / substeps_));
+        for (int s = 0; s < substeps_; ++s) x = integrator_step(dynamics(), x, h, loss_.integrator);
+        states.push_back(x.value());
+      }
+      return states;
+    };
+  }
+
+  const FieldTask& task_;
+  RolloutLossConfig loss_;
+  std::optional<SplitStretches> stretches_;
+  RolloutWindows train_windows_{}, test_windows_{};
+  int substeps_ = 1;
+  int asked_rollouts_ = 0, available_rollouts_ = 0;
+};
+
+}  // namespace
+
+void FieldTask::add_metrics(const Rollouts&, nlohmann::json&) const {}
+
+std::vector<Stretch> regular_stretches(const Batch& x, int points, double t_end) {
+  const std::vector<double> t = physics::linspace(0.0, t_end, points);
+  const Eigen::VectorXd times = Eigen::Map<const Eigen::VectorXd>(t.data(), points);
+  std::vector<Stretch> out;
+  for (Eigen::Index start = 0; start + points <= x.rows(); start += points)
+    out.push_back({times, x.middleRows(start, points)});
+  return out;
+}
+
+OscillatorSettings oscillator_settings(const nlohmann::json& s, OscillatorSettings paper,
+                                       const std::string& task) {
+  OscillatorSettings o = paper;
+  try {
+    if (s.contains("t_end")) o.t_end = s["t_end"].get<double>();
+    HNN_TASKS_CHECK(o.t_end > 0 && std::isfinite(o.t_end), "{}: t_end must be positive, got {}",
+                    task, o.t_end);
+    const double interval =
+        s.contains("sample_dt") ? s["sample_dt"].get<double>() : paper.t_end / (paper.points - 1);
+    HNN_TASKS_CHECK(interval > 0 && std::isfinite(interval),
+                    "{}: sample_dt must be positive, got {}", task, interval);
+    if (!s.contains("t_end") && !s.contains("sample_dt")) return paper;
+    const double intervals = std::round(o.t_end / interval);
+    HNN_TASKS_CHECK(intervals >= 1 && std::abs(o.t_end / interval - intervals) < 1e-6 * intervals,
+                    "{}: sample_dt {} does not divide t_end {} into whole intervals", task,
+                    interval, o.t_end);
+    o.points = int(intervals) + 1;
+  } catch (const nlohmann::json::exception& e) {
+    throw Error(fmt::format("{}: bad settings {}: {}", task, s.dump(), e.what()));
+  }
+  return o;
+}
+
+std::optional<SplitStretches> FieldTask::stretches(const RunSettings&, const Dataset&) const {
+  return std::nullopt;
+}
+
+void FieldTask::check_task_settings(const nlohmann::json& settings) const {
+  const std::vector<std::string> own = own_setting_names(), rollouts = evaluation_setting_names();
+  std::vector<std::string> known = rollout_setting_names();
+  known.insert(known.end(), own.begin(), own.end());
+  known.insert(known.end(), rollouts.begin(), rollouts.end());
+  for (const auto& [key, value] : settings.items()) {
+    HNN_TASKS_CHECK(std::find(known.begin(), known.end(), key) != known.end(),
+                    "task '{}' has no setting '{}' (known: {})", name(), key,
+                    fmt::join(known, ", "));
+  }
+  rollout_loss_config(settings, name());
+  rollout_config(settings);
+}
+
+std::unique_ptr<TaskRun> FieldTask::open(const RunSettings& settings) const {
+  return std::make_unique<FieldRun>(*this, settings);
+}
+
+Dataset FieldTask::build_dataset(std::uint64_t seed) const {
+  return build_dataset(RunSettings{.task = name(), .seed = seed});
+}
+
+}  // namespace hnn::tasks
