@@ -22,6 +22,12 @@ TITLES = {"spring": "Ideal mass-spring", "pendulum": "Ideal pendulum",
 MODELS = ["baseline", "hnn"]
 COLORS = {"truth": "black", "baseline": "tab:red", "hnn": "tab:blue"}
 LABELS = {"truth": "Ground truth", "baseline": "Baseline NN", "hnn": "Hamiltonian NN"}
+# Charts 3 and 4 of docs/speed_accuracy.md (charts/float_double.py, charts/model_size.py).
+SHORT_TITLES = {"spring": "Mass-spring", "pendulum": "Pendulum", "real-pendulum": "Real pendulum",
+                "two-body": "Two-body", "three-body": "Three-body",
+                "pixel-pendulum": "Pixel pendulum"}
+SIZE_COLORS = {"hnn": "tab:blue", "baseline": "tab:orange"}
+SIZE_LABELS = {"hnn": "HNN", "baseline": "baseline"}
 PIXEL_TASK = "pixel-pendulum"  # rollouts of frames, drawn by charts/fig4_pixel.py
 # The measurement charts (docs/speed_accuracy.md) draw a light grid; used as plt.rc_context.
 GRID = {"axes.grid": True, "grid.alpha": 0.3}
@@ -57,6 +63,11 @@ def is_number(value):
 
 # ---------------------------------------------------------------------------------------------
 # Reading
+
+
+def present(rows):
+    """The tasks of TASKS that some row ({"task": ...}) is of, in the paper's order."""
+    return [t for t in TASKS if any(r["task"] == t for r in rows)]
 
 
 def read_json(path):
