@@ -1,22 +1,30 @@
 #!/usr/bin/python3
-"""Tests scripts/plot.py on a synthetic results folder: a spring (exact circles for the truth, a
-slowly spiralling baseline, an HNN close to the truth), a two-body circular orbit, and a
-three-body rotating triangle whose baseline diverges to inf/nan.
+"""Tests the charts package (scripts/charts/) through its commands. scripts/plot.py on a synthetic
+results folder: a spring (exact circles for the truth, a slowly spiralling baseline, an HNN close
+to the truth), a two-body circular orbit, and a three-body rotating triangle whose baseline
+diverges to inf/nan; scripts/plot_pixel.py on synthetic pixel files; scripts/plot_study.py on
+synthetic tables of hnn sweep (results.csv): the lean choice and the results tables.
 
 Usage: /usr/bin/python3 scripts/plot_test.py [-v]      (KEEP=DIR keeps the folder in DIR)
 """
 
+import csv
 import json
 import os
 import shutil
 import struct
 import subprocess
+import sys
 import tempfile
 import unittest
 
 import numpy as np
 
-PLOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "plot.py")
+SCRIPTS = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, SCRIPTS)
+from charts import lean, sweep_table  # noqa: E402  (the package beside this file)
+
+PLOT = os.path.join(SCRIPTS, "plot.py")
 PYTHON = "/usr/bin/python3"
 KEYS = ["train_loss", "test_loss", "energy_mse"]
 MODELS = ["baseline", "hnn"]
@@ -218,8 +226,68 @@ def build_results(root):
 # Tests
 
 
-def run_plot(*args):
-    return subprocess.run([PYTHON, PLOT, *args], capture_output=True, text=True, timeout=300)
+def run_plot(*args, script=PLOT):
+    return subprocess.run([PYTHON, script, *args], capture_output=True, text=True, timeout=300)
+
+
+def write_pixel_results(root):
+    """The files `hnn reproduce`, `hnn bump` and `hnn reversibility --report` write for the pixel
+    pendulum: rollouts of decoded frames, the latent grid and paths, the bump, the strip."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    for m in MODELS:
+        folder = os.path.join(root, "pixel-pendulum", m)
+        os.makedirs(folder, exist_ok=True)
+        drift = 0.01 if m == "baseline" else 0.001
+        with open(os.path.join(folder, "pixel_rollout.csv"), "w") as f:
+            f.write("traj,frame,frame_mse,true_energy,pred_energy,pred_theta,true_theta\n")
+            for k in range(3):
+                for i in range(40):
+                    f.write(f"{k},{i},{1e-3 * (1 + drift * 10 * i):.6g},{1 + 0.1 * k:.6g},"
+                            f"{1 + 0.1 * k + drift * i:.6g},{np.sin(i / 5):.6g},"
+                            f"{np.sin(i / 5):.6g}\n")
+        with open(os.path.join(folder, "latent_grid.csv"), "w") as f:
+            f.write("z_q,z_p,learned_h,dz_q,dz_p\n")
+            for a in np.linspace(-1, 1, 10):
+                for b in np.linspace(-1, 1, 10):
+                    h = "" if m == "baseline" else f"{a * a + b * b:.6g}"
+                    f.write(f"{a:.6g},{b:.6g},{h},{b:.6g},{-a:.6g}\n")
+        with open(os.path.join(folder, "latent_paths.csv"), "w") as f:
+            f.write("traj,k,z_q,z_p\n")
+            for k, r in enumerate((0.3, 0.6)):
+                for i in range(30):
+                    f.write(f"{k},{i},{r * np.cos(i / 5):.6g},{r * np.sin(i / 5):.6g}\n")
+    with open(os.path.join(root, "pixel-pendulum", "hnn", "bump.csv"), "w") as f:
+        f.write("phase,t,z_q,z_p,learned_h,energy\n")
+        for t in range(60):
+            phase = ("symplectic", "riemann", "symplectic-after")[t // 20]
+            r = 0.5 + 0.3 * min(max(t - 20, 0), 19) / 19
+            f.write(f"{phase},{t},{r * np.cos(t / 5):.6g},{r * np.sin(t / 5):.6g},{r * r:.6g},"
+                    f"{1.1 * r * r:.6g}\n")
+    strip = np.random.default_rng(0).random((90, 5 * 58 + 2))
+    plt.imsave(os.path.join(root, "pixel-pendulum", "rollout_strip.png"), strip, cmap="gray")
+    with open(os.path.join(root, "reversibility.json"), "w") as f:
+        json.dump([{"task": "pixel-pendulum", "model": m, "volume": {"abs_log_det_mean": 1e-6},
+                    "integrators": [{"integrator": name, "return_distance_mean": 1e-7 * (j + 1)}
+                                    for j, name in enumerate(["midpoint", "rk4", "dopri5"])]}
+                   for m in MODELS], f)
+
+
+def write_sweep_table(folder, keys, runs):
+    """SWEEP_DIR/results.csv as hnn sweep writes it: run, status, reason, the spec's keys, where
+    and how long each run ran, then the metrics' keys; runs: (values, status, metrics)."""
+    os.makedirs(folder, exist_ok=True)
+    metric_keys = sorted({k for _, _, metrics in runs for k in metrics})
+    with open(os.path.join(folder, "results.csv"), "w", newline="") as f:
+        w = csv.writer(f, lineterminator="\n")
+        w.writerow(["run", "status", "reason", *keys, "run_host", "run_seconds", "run_resumed",
+                    *metric_keys])
+        for i, (values, status, metrics) in enumerate(runs):
+            w.writerow([f"{values['task']}/{values['model']}/run{i}", status,
+                        "diverged" if status == "failed" else "",
+                        *[values.get(k, "") for k in keys], "host", "1.0", "false",
+                        *[metrics.get(k, "") for k in metric_keys]])
 
 
 def png_size(path):
@@ -331,6 +399,13 @@ class PlotTest(unittest.TestCase):
         drawn = [n for n in os.listdir(folder) if n.endswith((".png", ".svg"))]
         self.assertEqual(drawn, [], "inputs are all read before any chart is written")
 
+    def test_help_says_what_it_draws(self):
+        for script in ("plot.py", "plot_pixel.py", "plot_speed_accuracy.py", "plot_study.py"):
+            run = run_plot("--help", script=os.path.join(SCRIPTS, script))
+            self.assertEqual(run.returncode, 0, run.stderr)
+            self.assertIn("usage:", run.stdout)
+        self.assertIn("fig2_<task>", run_plot("--help").stdout)
+
     def test_missing_folder_is_an_error(self):
         run = run_plot(os.path.join(self.root, "does-not-exist"))
         self.assertEqual(run.returncode, 1)
@@ -405,6 +480,125 @@ class PlotTest(unittest.TestCase):
         self.assertEqual(run.returncode, 1, run.stderr)
         self.assertIn("two hnn runs", run.stderr)
         self.assertNotIn("Traceback", run.stderr)
+
+
+class PixelTest(unittest.TestCase):
+    def test_draws_the_pixel_figures_and_reversibility(self):
+        root = tempfile.mkdtemp(prefix="plot_pixel_test_")
+        try:
+            write_pixel_results(root)
+            run = run_plot(root, script=os.path.join(SCRIPTS, "plot_pixel.py"))
+            self.assertEqual(run.returncode, 0, run.stderr)
+            for stem in ("fig4_pixel_pendulum", "figC1_pixel_latent", "fig5_pixel_bump",
+                         "reversibility"):
+                png = os.path.join(root, stem + ".png")
+                self.assertIn(png, run.stdout.split())
+                self.assertGreater(png_size(png)[0], 600, png)
+            os.remove(os.path.join(root, "pixel-pendulum", "hnn", "bump.csv"))
+            run = run_plot(root, script=os.path.join(SCRIPTS, "plot_pixel.py"))
+            self.assertEqual(run.returncode, 0, run.stderr)
+            self.assertIn("bump.csv: missing (run `hnn bump`)", run.stderr)
+        finally:
+            shutil.rmtree(root, ignore_errors=True)
+
+
+def size_runs():
+    """The model-size study of one task: 200-200 in float and double, widths 16, 32 and 200 with
+    seeds 0-2 in double; 16-16 is 3 times worse than 200-200, 32-32 within its noise."""
+    runs = []
+    for dtype in ("float", "double"):
+        for model in MODELS:
+            runs.append(({"task": "spring", "model": model, "dtype": dtype, "hidden": "200-200",
+                          "seed": 0}, "done",
+                         {"test_loss": 0.036, "test_loss_se": 0.002, "energy_mse": 3e-4,
+                          "energy_mse_se": 1e-4, "train_seconds": 20.0 if dtype == "double"
+                          else 10.0}))
+    for hidden, worse, seconds in (("16-16", 3.0, 0.4), ("32-32", 1.02, 1.0),
+                                   ("200-200", 1.0, 20.0)):
+        for seed in (0, 1, 2):
+            if hidden == "200-200" and seed == 0:
+                continue  # the float/double part's double run above
+            runs.append(({"task": "spring", "model": "hnn", "dtype": "double", "hidden": hidden,
+                          "seed": seed}, "done",
+                         {"test_loss": 0.036 * worse * (1 + 0.01 * seed), "test_loss_se": 0.002,
+                          "energy_mse": 3e-4 * worse, "energy_mse_se": 1e-4,
+                          "train_seconds": seconds}))
+    runs.append(({"task": "spring", "model": "hnn", "dtype": "double", "hidden": "64-64",
+                  "seed": 0}, "failed", {}))
+    return runs
+
+
+class StudyTest(unittest.TestCase):
+    def setUp(self):
+        self.root = tempfile.mkdtemp(prefix="plot_study_test_")
+
+    def tearDown(self):
+        shutil.rmtree(self.root, ignore_errors=True)
+
+    def study(self, *args):
+        return run_plot(*args, script=os.path.join(SCRIPTS, "plot_study.py"))
+
+    def test_model_size_draws_charts_3_and_4_and_chooses_the_lean_model(self):
+        sweep, out = os.path.join(self.root, "sweep"), os.path.join(self.root, "charts")
+        write_sweep_table(sweep, ["task", "model", "dtype", "hidden", "seed"], size_runs())
+        run = self.study("model_size", sweep, "--out", out)
+        self.assertEqual(run.returncode, 0, run.stderr)
+        self.assertIn("spring/hnn/run", run.stderr)  # the failed run, noted
+        for name in ("float_double.png", "model_size.png", "model_size.csv", "lean.csv"):
+            self.assertIn(os.path.join(out, name), run.stdout.split())
+        with open(os.path.join(out, "lean.csv")) as f:
+            rows = list(csv.DictReader(f))
+        self.assertEqual([(r["config"], r["hidden"], r["params"], r["seeds"]) for r in rows],
+                         [("paper", "200-200", "41001", "3"), ("lean", "32-32", "1185", "3")])
+        self.assertEqual(rows[1]["speedup_wall"], "20")
+
+    def test_lean_keeps_the_paper_model_when_no_smaller_one_is_within_the_noise(self):
+        rows = sweep_table.with_sizes(
+            [dict({k: str(v) for k, v in values.items()}, run="r",
+                  **{k: str(v) for k, v in metrics.items()})
+             for values, status, metrics in size_runs()
+             if status == "done" and values["hidden"] != "32-32"], "results.csv")
+        stats = lean.config_stats(rows)
+        self.assertEqual(lean.choose_lean(stats, "spring")[0], "200-200")
+        self.assertEqual(lean.choose_lean(stats, "pendulum"), (None, None))
+
+    def test_a_table_without_the_study_s_columns_is_an_error_naming_it(self):
+        sweep = os.path.join(self.root, "sweep")
+        write_sweep_table(sweep, ["task", "model"], [({"task": "spring", "model": "hnn"},
+                                                      "done", {"test_loss": 1.0})])
+        run = self.study("model_size", sweep)
+        self.assertEqual(run.returncode, 1, run.stderr)
+        self.assertIn(os.path.join(sweep, "results.csv") + ": no column(s) dtype, hidden, seed",
+                      run.stderr)
+        run = self.study("rollout", os.path.join(self.root, "nowhere"))
+        self.assertEqual(run.returncode, 1, run.stderr)
+        self.assertIn("results.csv: missing (run `hnn sweep SPEC", run.stderr)
+
+    def test_rollout_table_groups_runs_by_data_and_integrator_and_counts_failures(self):
+        keys = ["task", "model", "settings", "seed", "loss", "integrator", "horizon"]
+        coarse = '{"sample_dt":1.0,"t_end":6}'
+        runs = [({"task": "spring", "model": "hnn", "settings": coarse, "seed": s}, "done",
+                 {"stretch_state_mse": v, "truth_leapfrog_state_mse": truth})
+                for s, v, truth in ((0, 0.02, 1e-4), (1, 0.04, 3e-4))]
+        runs += [({"task": "spring", "model": "hnn", "settings": coarse, "seed": 0,
+                   "loss": "rollout", "integrator": "leapfrog", "horizon": 1}, "done",
+                  {"stretch_state_mse": 0.005}),
+                 ({"task": "spring", "model": "hnn", "settings": coarse, "seed": 1,
+                   "loss": "rollout", "integrator": "leapfrog", "horizon": 1}, "failed", {})]
+        sweep = os.path.join(self.root, "rollout")
+        write_sweep_table(sweep, keys, runs)
+        run = self.study("rollout", sweep)
+        self.assertEqual(run.returncode, 0, run.stderr)
+        with open(os.path.join(sweep, "results.md")) as f:
+            text = f.read()
+        self.assertIn("| spring-dt1.0 | 0.03 ± 0.01 | 0.005 (1 failed) | 0.0002 ± 0.0001 |", text)
+        self.assertIn("| pendulum-dt0.5 | n/a | n/a | n/a |", text)
+        self.assertIn("- spring/hnn/run3: diverged", text)
+
+    def test_mean_and_standard_error_over_seeds(self):
+        self.assertEqual(sweep_table.mean_se([1.0, 3.0, None]), (2.0, 1.0, 2))
+        self.assertEqual(sweep_table.cell([2.0]), "2")
+        self.assertEqual(sweep_table.cell([1.0, 3.0]), "2 ± 1")
 
 
 if __name__ == "__main__":
