@@ -100,7 +100,7 @@ BENCHMARK_TEMPLATE(BM_SpringTrainingStep, double)
 
 // ---- 2. grad H: autodiff vs finite differences vs analytic ----------------------------------
 
-// The pendulum H = 3 (1 - cos q) + p^2 of shared/spec/tasks.md, x = (q, p).
+// The pendulum H = 3 (1 - cos q) + p^2 of docs/tasks.md, x = (q, p).
 struct Pendulum {
   static constexpr Eigen::Index kDim = 2;
   template <typename T>

@@ -40,7 +40,7 @@ ModelKind parse_model_kind(std::string_view name);
 FieldType parse_field_type(std::string_view name);
 
 /// Everything that defines a dynamics model but its parameters. The defaults are the paper's
-/// (tasks.md): dim -> 200 -> 200 -> out, tanh, orthogonal, last layer without bias.
+/// (docs/tasks.md): dim -> 200 -> 200 -> out, tanh, orthogonal, last layer without bias.
 struct DynamicsConfig {
   ModelKind model = ModelKind::kHnn;
   Index dim = 2;  // state size 2n, x = (q_1..q_n, p_1..p_n); even for an HNN

@@ -20,7 +20,7 @@ class DoublePendulum : public System {
   std::string name() const override { return "double_pendulum"; }
   Eigen::VectorXd hamiltonian_batch(const Batch& x) const override;
   void vector_field(const Batch& x, Batch& dxdt) const override;
-  /// Not in tasks.md: angles U[-pi/2, pi/2], angular velocities U[-1, 1].
+  /// Not in docs/tasks.md: angles U[-pi/2, pi/2], angular velocities U[-1, 1].
   Batch sample_initial_states(int n, std::mt19937_64& rng) const override;
 
   /// (theta1, theta2, omega1, omega2) rows -> (theta1, theta2, p1, p2): p = M omega.

@@ -16,7 +16,7 @@ struct GymState {
 };
 
 /// The scene. As a System it is the continuous-time pendulum in the canonical
-/// coordinates of tasks.md: theta from hanging down, p = 0.25 dtheta/dt, so
+/// coordinates of docs/tasks.md: theta from hanging down, p = 0.25 dtheta/dt, so
 /// H = 0.25 (3g/2l) (1 - cos theta) + p^2 / (2 * 0.25) = 3.75 (1 - cos theta) + 2 p^2.
 /// (The rod's mechanical energy is 4/3 of this H.)
 class GymPendulum : public Pendulum {
@@ -42,7 +42,7 @@ class GymPendulum : public Pendulum {
   GymState step(GymState s) const;
   /// `frames` states: s0 and its frames - 1 successors.
   std::vector<GymState> rollout(GymState s0, int frames) const;
-  /// A trial start of tasks.md: |theta| in (0, pi/6), thdot ~ U[-1, 1].
+  /// A trial start of docs/tasks.md: |theta| in (0, pi/6), thdot ~ U[-1, 1].
   GymState sample_gym_state(std::mt19937_64& rng) const;
 
   /// (theta, p): theta = th - pi wrapped to (-pi, pi], p = 0.25 thdot.

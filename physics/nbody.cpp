@@ -118,7 +118,7 @@ Batch NBody::sample_initial_states(int n, std::mt19937_64& rng) const {
   throw std::logic_error(fmt::format("no initial-state sampler for {} bodies", bodies()));
 }
 
-// tasks.md, task 4: body 1 at pos ~ U[0.5, 1.5]^2, body 2 at -pos, velocities of
+// docs/tasks.md, task 4: body 1 at pos ~ U[0.5, 1.5]^2, body 2 at -pos, velocities of
 // a circular orbit scaled by (1 + 0.05 n), n ~ N(0, 1), body 2 opposite.
 Batch NBody::sample_two_body(int n, std::mt19937_64& rng) const {
   std::uniform_real_distribution<double> u(0.5, 1.5);
@@ -139,7 +139,7 @@ Batch NBody::sample_two_body(int n, std::mt19937_64& rng) const {
   return x;
 }
 
-// tasks.md, task 4b: a rotating equilateral triangle of radius U[0.9, 1.2],
+// docs/tasks.md, task 4b: a rotating equilateral triangle of radius U[0.9, 1.2],
 // each velocity component scaled by (1 + 0.2 u), u ~ U[-1, 1].
 Batch NBody::sample_three_body(int n, std::mt19937_64& rng) const {
   std::uniform_real_distribution<double> unit(-1.0, 1.0), radius(0.9, 1.2);

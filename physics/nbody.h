@@ -1,5 +1,5 @@
 // Planar N-body gravity (tasks 4 and 4b): H, field, conserved quantities and
-// the two- and three-body initial-state samplers of tasks.md.
+// the two- and three-body initial-state samplers of docs/tasks.md.
 #pragma once
 
 #include <vector>
@@ -26,7 +26,7 @@ class NBody : public SeparableSystem {
   Eigen::VectorXd hamiltonian_batch(const Batch& x) const override;
   void velocity(const BatchView& p, BatchSpan dq) const override;
   void force(const BatchView& q, BatchSpan dp) const override;
-  /// Two bodies: tasks.md's near-circular orbits; three bodies: its perturbed
+  /// Two bodies: docs/tasks.md's near-circular orbits; three bodies: its perturbed
   /// rotating triangles. Other N: not specified, throws std::logic_error.
   Batch sample_initial_states(int n, std::mt19937_64& rng) const override;
 

@@ -8,7 +8,7 @@
 namespace hnn::physics {
 
 struct SimulateOptions {
-  double rtol = 1e-9;     ///< tasks.md integrates at rtol 1e-9 (1e-10 for the spring)
+  double rtol = 1e-9;     ///< docs/tasks.md integrates at rtol 1e-9 (1e-10 for the spring)
   double atol = 1e-12;    ///< tight, so rtol governs (SciPy's default 1e-6 would not)
   bool use_exact = true;  ///< use the closed form when the system has one
 };

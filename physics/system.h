@@ -40,7 +40,7 @@ class System {
   virtual Eigen::VectorXd energy_batch(const Batch& x) const { return hamiltonian_batch(x); }
   double energy(const Eigen::Ref<const Eigen::RowVectorXd>& x) const;
 
-  /// n initial states drawn as tasks.md specifies for this system.
+  /// n initial states drawn as docs/tasks.md specifies for this system.
   virtual Batch sample_initial_states(int n, std::mt19937_64& rng) const = 0;
 
   /// The state after time t from each row of x0, when a closed form exists.

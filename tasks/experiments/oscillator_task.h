@@ -1,7 +1,7 @@
 #pragma once
 // Internal to tasks/: what the spring and the pendulum (tasks 1 and 2) share. 50 noisy
 // trajectories of one system (oscillator_dataset), settings sample_dt and t_end, stretches for
-// the rollout loss, rollouts from the evaluation states of tasks.md.
+// the rollout loss, rollouts from the evaluation states of docs/tasks.md.
 
 #include "physics/oscillators.h"
 #include "tasks/data/trajectories.h"

@@ -12,7 +12,7 @@ inline constexpr int kFramePixels = physics::GymPendulum::kSide * physics::GymPe
 inline constexpr int kPairPixels = 2 * kFramePixels;  // the model's input: two frames
 
 /// Everything that defines a pixel-pendulum run but the model kind and the seed. The defaults
-/// are the reference implementation's (tasks.md, task 5); tests use smaller ones.
+/// are the reference implementation's (docs/tasks.md, task 5); tests use smaller ones.
 struct PixelConfig {
   int trials = 200;            // Gym trials, each from sample_gym_state
   int frames_per_trial = 103;  // frames (Gym states) per trial; pairs per trial = this - 3

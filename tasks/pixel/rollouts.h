@@ -18,7 +18,7 @@ struct PixelRollouts {
   Eigen::MatrixXd frame_mse;                        // trajectories x times: MSE of the decoded pair
   Eigen::MatrixXd true_theta, true_p, true_energy;  // pair_state of the true angles
   /// pair_state of the angles of the first frames of decoded pairs k and k + 1: the rollout's
-  /// own frames over time (Note [Velocity from the rollout's frames], pixel_rollout.cpp).
+  /// own frames over time (Note [Velocity from the rollout's frames], tasks/pixel/rollouts.cpp).
   Eigen::MatrixXd pred_theta, pred_p, pred_energy;
   Eigen::MatrixXd pair_energy;    // from the two frames of one decoded pair (decoder-biased)
   Eigen::MatrixXd frames_energy;  // recovered from the true frames: the method's floor

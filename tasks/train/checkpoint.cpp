@@ -1,5 +1,5 @@
 // Training checkpoints: the matrices through nn's parameter files, the rest as JSON, committed
-// in the order of Note [Checkpoint commit] (train_checkpoint.h).
+// in the order of Note [Checkpoint commit] (tasks/train/checkpoint.h).
 
 #include "tasks/train/checkpoint.h"
 

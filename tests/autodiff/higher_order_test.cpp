@@ -206,7 +206,7 @@ TEST(Hamiltonians, TwoBodyGradientIsAnalytic) {
 }
 
 TEST(Hamiltonians, SymplecticFieldOfTheSpringIsItsExactMotion) {
-  // J grad H for H = q^2 + p^2 gives dq/dt = 2p, dp/dt = -2q (shared/spec/tasks.md, task 1).
+  // J grad H for H = q^2 + p^2 gives dq/dt = 2p, dp/dt = -2q (docs/tasks.md, task 1).
   ad::TapeScope scope;
   const MatrixD x0 = random_matrix(10, 2, 14);
   const VarD x = VarD::leaf(x0);

@@ -1,6 +1,6 @@
 #pragma once
 // Shared helpers of the autodiff tests: seeded random matrices, a tanh MLP written with engine
-// ops, the HNN loss, and the task Hamiltonians of shared/spec/tasks.md.
+// ops, the HNN loss, and the task Hamiltonians of docs/tasks.md.
 
 #include <unistd.h>
 

@@ -11,7 +11,8 @@
 namespace hnn::nn::testing {
 
 /// States x = (q, p) and exact derivatives of H = q^2 + p^2 (dq/dt = 2p, dp/dt = -2q), as in
-/// tasks.md task 1: radius U[0.1, 1], 30 points over t in [0, 3], Gaussian noise on the inputs.
+/// docs/tasks.md task 1: radius U[0.1, 1], 30 points over t in [0, 3], Gaussian noise on the
+/// inputs.
 struct SpringData {
   Matrix<double> x, dxdt;
 };

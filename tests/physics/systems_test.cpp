@@ -1,5 +1,5 @@
 // Systems: each field against finite differences of its H, the samplers
-// against tasks.md, closed forms and conversions.
+// against docs/tasks.md, closed forms and conversions.
 #include <gtest/gtest.h>
 
 #include <cmath>

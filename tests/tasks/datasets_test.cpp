@@ -1,5 +1,5 @@
-// The datasets of tasks 1-4b against tasks.md: sizes and splits, targets equal to the true field
-// at the clean states, the noise level, the samplers' distributions, and determinism.
+// The datasets of tasks 1-4b against docs/tasks.md: sizes and splits, targets equal to the true
+// field at the clean states, the noise level, the samplers' distributions, and determinism.
 
 #include <gtest/gtest.h>
 
