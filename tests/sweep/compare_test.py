@@ -17,7 +17,7 @@ import unittest
 
 HNN = os.environ.get("HNN_EXE", "build/apps/hnn")
 SOURCE = os.environ.get("HNN_SOURCE_DIR", os.getcwd())
-PEERS = os.path.join(SOURCE, "tasks", "report", "peers.json")
+PEERS = os.path.join(SOURCE, "apps", "hnn", "compare", "peers.json")
 
 
 def hnn(*args):
