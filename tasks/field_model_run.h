@@ -3,8 +3,8 @@
 // Dataset shares: a fresh model from the run's seed, training with FieldObjective, saving and
 // loading. What a task evaluates and rolls out is its own (FieldRun, DataRun).
 
-#include "nn/checkpoint.h"
 #include "nn/hnn.h"
+#include "nn/parameter_file.h"
 #include "tasks/field_task.h"
 #include "tasks/trained_model.h"
 
