@@ -55,8 +55,8 @@ PixelObjective<T>::PixelObjective(PixelModel<T>& model, const PixelData& data,
 // PixelConfig::dynamics_weight_decay).
 template <typename T>
 std::vector<nn::AdamGroup<T>> PixelObjective<T>::parameter_groups() const {
-  nn::AdamGroup<T> autoencoder{
-      {}, {.lr = config_.learning_rate, .weight_decay = config_.weight_decay}};
+  nn::AdamGroup<T> autoencoder{{},
+                               {.lr = config_.learning_rate, .weight_decay = config_.weight_decay}};
   nn::AdamGroup<T> dynamics{
       {}, {.lr = config_.learning_rate, .weight_decay = config_.dynamics_weight_decay}};
   for (const nn::NamedParameter<T>& p : model_.named_parameters())

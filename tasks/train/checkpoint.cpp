@@ -6,9 +6,9 @@
 #include <cmath>
 #include <fstream>
 
+#include "nn/atomic_file.h"
 #include "nn/parameter_file.h"
 #include "tasks/error.h"
-#include "nn/atomic_file.h"
 #include "tasks/report/json_values.h"
 #include "tasks/train/stop.h"
 
@@ -92,8 +92,8 @@ TrainState from_json(const json& j) {
 }  // namespace
 
 template <typename T>
-void save_train_checkpoint(const fs::path& dir, const nn::Module<T>& model,
-                           const nn::Adam<T>& adam, TrainState state) {
+void save_train_checkpoint(const fs::path& dir, const nn::Module<T>& model, const nn::Adam<T>& adam,
+                           TrainState state) {
   fs::create_directories(dir);
   state.params_file = fmt::format("step-{:09d}.bin", state.step);
   const nn::AdamState<T> moments = adam.state();
