@@ -15,8 +15,8 @@
 #include <random>
 #include <string>
 
-#include "nn/checkpoint.h"
 #include "nn/hnn.h"
+#include "nn/parameter_file.h"
 #include "physics/lipson.h"
 #include "physics/types.h"
 #include "tasks/data/table.h"
@@ -81,13 +81,13 @@ inline void lipson_input(const std::string& path) {
   }
 }
 
-/// nn::read_checkpoint_info, then nn::load_parameters into an HNN 2-8-1 (double and float):
+/// nn::read_parameter_file_info, then nn::load_parameters into an HNN 2-8-1 (double and float):
 /// refused inputs must leave the model unchanged.
 inline void parameters_input(const std::string& path) {
-  nn::CheckpointInfo info;
+  nn::ParameterFileInfo info;
   try {
-    info = nn::read_checkpoint_info(path);
-  } catch (const nn::CheckpointError&) {
+    info = nn::read_parameter_file_info(path);
+  } catch (const nn::ParameterFileError&) {
   }
   FUZZ_CHECK(info.entries.size() < (1u << 20));
   nn::DynamicsConfig config;
@@ -98,7 +98,7 @@ inline void parameters_input(const std::string& path) {
       const auto before = model->parameters().front().value();
       try {
         nn::load_parameters(path, *model);
-      } catch (const nn::CheckpointError&) {
+      } catch (const nn::ParameterFileError&) {
         FUZZ_CHECK(model->parameters().front().value() == before);
       }
     };

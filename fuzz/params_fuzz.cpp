@@ -1,4 +1,4 @@
-// libFuzzer harness: the parameter-file reader (read_checkpoint_info, load_parameters).
+// libFuzzer harness: the parameter-file reader (read_parameter_file_info, load_parameters).
 
 #include "fuzz/fuzz_targets.h"
 

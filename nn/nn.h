@@ -2,8 +2,8 @@
 // The whole public API of the nn module.
 
 #include "nn/activation.h"
+#include "nn/atomic_file.h"
 #include "nn/autoencoder.h"
-#include "nn/checkpoint.h"
 #include "nn/dynamics.h"
 #include "nn/hnn.h"
 #include "nn/init.h"
@@ -13,3 +13,4 @@
 #include "nn/mlp.h"
 #include "nn/module.h"
 #include "nn/optim.h"
+#include "nn/parameter_file.h"

@@ -3,16 +3,22 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <set>
 #include <stdexcept>
 
 namespace hnn::nn {
 
 template <typename T>
 Optimizer<T>::Optimizer(std::vector<ad::Var<T>> parameters) : parameters_(std::move(parameters)) {
+  std::set<const Matrix<T>*> seen;  // a leaf's value lives as long as the leaf: its identity
   for (std::size_t i = 0; i < parameters_.size(); ++i) {
     if (!parameters_[i].defined() || !parameters_[i].is_leaf()) {
       throw std::invalid_argument(fmt::format(
           "optimizer: parameter #{} is not a leaf; only leaves can be updated in place", i));
+    }
+    if (!seen.insert(&parameters_[i].value()).second) {
+      throw std::invalid_argument(fmt::format(
+          "optimizer: parameter #{} is listed twice; it would be updated twice a step", i));
     }
   }
 }
@@ -56,23 +62,55 @@ void check_non_negative(const char* what, const char* name, double value) {
     throw std::invalid_argument(fmt::format("{}: {} must be >= 0, got {}", what, name, value));
   }
 }
+
+// The groups' parameters end to end.
+template <typename T>
+std::vector<ad::Var<T>> joined(const std::vector<AdamGroup<T>>& groups) {
+  std::vector<ad::Var<T>> all;
+  for (const AdamGroup<T>& group : groups) {
+    all.insert(all.end(), group.parameters.begin(), group.parameters.end());
+  }
+  return all;
+}
+
+void check_adam(const AdamOptions& o, const std::string& what) {
+  check_non_negative(what.c_str(), "lr", o.lr);
+  check_non_negative(what.c_str(), "eps", o.eps);
+  check_non_negative(what.c_str(), "weight_decay", o.weight_decay);
+  for (double beta : {o.beta1, o.beta2}) {
+    if (!(beta >= 0 && beta < 1)) {
+      throw std::invalid_argument(fmt::format("{}: betas must be in [0, 1), got {}", what, beta));
+    }
+  }
+}
 }  // namespace
 
 template <typename T>
 Adam<T>::Adam(std::vector<ad::Var<T>> parameters, AdamOptions options)
-    : Optimizer<T>(std::move(parameters)), options_(options) {
-  check_non_negative("Adam", "lr", options_.lr);
-  check_non_negative("Adam", "eps", options_.eps);
-  check_non_negative("Adam", "weight_decay", options_.weight_decay);
-  for (double beta : {options_.beta1, options_.beta2}) {
-    if (!(beta >= 0 && beta < 1)) {
-      throw std::invalid_argument(fmt::format("Adam: betas must be in [0, 1), got {}", beta));
-    }
+    : Adam(std::vector<AdamGroup<T>>{{std::move(parameters), options}}) {}
+
+template <typename T>
+Adam<T>::Adam(const std::vector<AdamGroup<T>>& groups) : Optimizer<T>(joined(groups)) {
+  if (groups.empty()) throw std::invalid_argument("Adam: no parameter groups");
+  for (std::size_t k = 0; k < groups.size(); ++k) {
+    check_adam(groups[k].options, groups.size() == 1 ? "Adam" : fmt::format("Adam group {}", k));
+    options_.push_back(groups[k].options);
+    group_.insert(group_.end(), groups[k].parameters.size(), k);
   }
   for (const ad::Var<T>& p : this->parameters_) {
     m_.push_back(Matrix<T>::Zero(p.rows(), p.cols()));
     v_.push_back(Matrix<T>::Zero(p.rows(), p.cols()));
   }
+}
+
+template <typename T>
+void Adam<T>::set_lr(double lr) {
+  for (AdamOptions& o : options_) o.lr = lr;
+}
+
+template <typename T>
+void Adam<T>::set_lr(std::size_t group, double lr) {
+  options_.at(group).lr = lr;
 }
 
 template <typename T>
@@ -100,11 +138,12 @@ void Adam<T>::load_state(AdamState<T> state) {
 
 template <typename T>
 void Adam<T>::update(std::size_t i, Matrix<T>& p, const Matrix<T>& g) {
+  const AdamOptions& o = options_[group_[i]];
   const double t = double(this->steps_);
-  const T beta1 = T(options_.beta1), beta2 = T(options_.beta2);
-  const T step_size = T(options_.lr / (1.0 - std::pow(options_.beta1, t)));
-  const T bias_correction2_sqrt = T(std::sqrt(1.0 - std::pow(options_.beta2, t)));
-  const T eps = T(options_.eps), decay = T(options_.weight_decay);
+  const T beta1 = T(o.beta1), beta2 = T(o.beta2);
+  const T step_size = T(o.lr / (1.0 - std::pow(o.beta1, t)));
+  const T bias_correction2_sqrt = T(std::sqrt(1.0 - std::pow(o.beta2, t)));
+  const T eps = T(o.eps), decay = T(o.weight_decay);
   auto m = m_[i].array();
   auto v = v_[i].array();
   // One fused expression per buffer: no temporaries, so no allocation.

@@ -53,6 +53,14 @@ struct AdamOptions {
   double weight_decay = 0;
 };
 
+/// Parameters with their own Adam settings, as torch.optim.Adam's param_groups: e.g. weight decay
+/// on some layers only.
+template <typename T>
+struct AdamGroup {
+  std::vector<ad::Var<T>> parameters;
+  AdamOptions options;
+};
+
 /// Everything an Adam carries between steps, for training checkpoints: the step count (which the
 /// bias corrections use) and both moments of every parameter, in parameter order.
 template <typename T>
@@ -61,14 +69,23 @@ struct AdamState {
   std::vector<Matrix<T>> m, v;
 };
 
+/// One group, or several (torch.optim.Adam(param_groups)): parameters() lists the groups'
+/// parameters end to end, step(grads) takes their gradients in that order and updates each
+/// parameter with its group's options, and every group shares the step count.
 template <typename T>
 class Adam : public Optimizer<T> {
  public:
   explicit Adam(std::vector<ad::Var<T>> parameters, AdamOptions options = {});
+  /// At least one group; a parameter may be in one group only (std::invalid_argument).
+  explicit Adam(const std::vector<AdamGroup<T>>& groups);
 
-  const AdamOptions& options() const { return options_; }
-  double lr() const override { return options_.lr; }
-  void set_lr(double lr) override { options_.lr = lr; }
+  std::size_t group_count() const { return options_.size(); }
+  const AdamOptions& options(std::size_t group = 0) const { return options_.at(group); }
+  /// The first group's learning rate.
+  double lr() const override { return options_.front().lr; }
+  /// Sets every group's learning rate.
+  void set_lr(double lr) override;
+  void set_lr(std::size_t group, double lr);
   /// m and v of parameter i.
   const Matrix<T>& first_moment(std::size_t i) const { return m_.at(i); }
   const Matrix<T>& second_moment(std::size_t i) const { return v_.at(i); }
@@ -83,7 +100,8 @@ class Adam : public Optimizer<T> {
   void update(std::size_t i, Matrix<T>& parameter, const Matrix<T>& g) override;
 
  private:
-  AdamOptions options_;
+  std::vector<AdamOptions> options_;  // per group
+  std::vector<std::size_t> group_;    // per parameter: its group
   std::vector<Matrix<T>> m_, v_;
 };
 

@@ -7,7 +7,7 @@
 #include <memory>
 #include <variant>
 
-#include "nn/checkpoint.h"
+#include "nn/parameter_file.h"
 #include "tasks/error.h"
 
 namespace hnn::tasks {

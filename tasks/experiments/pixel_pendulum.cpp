@@ -7,7 +7,7 @@
 
 #include <algorithm>
 
-#include "nn/checkpoint.h"
+#include "nn/parameter_file.h"
 #include "tasks/experiments/registry.h"
 #include "tasks/pixel/evaluation.h"
 #include "tasks/pixel/objective.h"

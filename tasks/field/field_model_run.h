@@ -4,8 +4,8 @@
 // evaluates and rolls out is its own (FieldRun in field_task.cpp, DataRun in
 // tasks/experiments/data_task.cpp).
 
-#include "nn/checkpoint.h"
 #include "nn/hnn.h"
+#include "nn/parameter_file.h"
 #include "tasks/data/dataset.h"
 #include "tasks/task.h"
 #include "tasks/trained_model.h"

@@ -7,10 +7,10 @@
 #include <cmath>
 #include <numeric>
 
+#include "nn/atomic_file.h"
 #include "physics/integrator.h"
 #include "tasks/error.h"
 #include "tasks/pixel/rollouts.h"
-#include "tasks/report/atomic_file.h"
 #include "tasks/report/image_io.h"
 
 namespace hnn::tasks::pixel {
@@ -165,7 +165,7 @@ void record_phase(const PixelModel<double>& model, const physics::VectorField& s
 // bump.csv, bump.gif and bump_strip.png (every 4th image, in one row).
 std::vector<fs::path> write_bump_files(const Record& r, const fs::path& out) {
   fs::create_directories(out);
-  write_file_atomic(out / "bump.csv", r.csv);
+  nn::write_file_atomic(out / "bump.csv", r.csv);
   write_gif(out / "bump.gif", r.images, 5);
   const int stride = 4, tile = kSide * kScale + 2 * kGap;
   const int cols = int((r.images.size() - 1) / stride) + 1;

@@ -54,10 +54,10 @@ PixelObjective<T>::PixelObjective(PixelModel<T>& model, const PixelData& data,
 // PyTorch's param_groups: the latent model gets its own weight decay (see
 // PixelConfig::dynamics_weight_decay).
 template <typename T>
-std::vector<ParameterGroup<T>> PixelObjective<T>::parameter_groups() const {
-  ParameterGroup<T> autoencoder{
-      {}, {.lr = config_.learning_rate, .weight_decay = config_.weight_decay}};
-  ParameterGroup<T> dynamics{
+std::vector<nn::AdamGroup<T>> PixelObjective<T>::parameter_groups() const {
+  nn::AdamGroup<T> autoencoder{{},
+                               {.lr = config_.learning_rate, .weight_decay = config_.weight_decay}};
+  nn::AdamGroup<T> dynamics{
       {}, {.lr = config_.learning_rate, .weight_decay = config_.dynamics_weight_decay}};
   for (const nn::NamedParameter<T>& p : model_.named_parameters())
     (p.name.starts_with("dynamics.") ? dynamics : autoencoder).parameters.push_back(p.var);

@@ -17,7 +17,7 @@ class PixelObjective : public Objective<T> {
                  std::uint64_t seed);
 
   nn::Module<T>& model() override { return model_; }
-  std::vector<ParameterGroup<T>> parameter_groups() const override;
+  std::vector<nn::AdamGroup<T>> parameter_groups() const override;
   RowSampler& sampler() override { return sampler_; }
   ad::Var<T> batch_loss() override;
   /// The combined loss on the first curve_rows pairs of each split.

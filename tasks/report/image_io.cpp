@@ -16,7 +16,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "tasks/report/atomic_file.h"
+#include "nn/atomic_file.h"
 
 namespace hnn::tasks {
 
@@ -86,7 +86,7 @@ void write_png(const std::filesystem::path& path, const GrayImage& image) {
     throw image_error(path, png.message);
   }
   bytes.resize(size);
-  write_file_atomic(path, bytes);
+  nn::write_file_atomic(path, bytes);
 }
 
 void write_gif(const std::filesystem::path& path, const std::vector<GrayImage>& images,
@@ -138,7 +138,7 @@ void write_gif(const std::filesystem::path& path, const std::vector<GrayImage>& 
     }
   }
   if (EGifCloseFile(gif, &error) == GIF_ERROR) throw image_error(path, GifErrorString(error));
-  write_file_atomic(path, bytes);
+  nn::write_file_atomic(path, bytes);
 }
 
 GrayImage read_png(const std::filesystem::path& path) {

@@ -2,8 +2,8 @@
 
 #include <fmt/format.h>
 
+#include "nn/atomic_file.h"
 #include "tasks/error.h"
-#include "tasks/report/atomic_file.h"
 #include "tasks/report/json_values.h"
 
 namespace hnn::tasks {
@@ -17,7 +17,7 @@ void RunFolder::create() const {
 }
 
 void RunFolder::write_text(std::string_view name, std::string_view content) const {
-  write_file_atomic(file(name), content);
+  nn::write_file_atomic(file(name), content);
 }
 
 void RunFolder::write_metrics(const nlohmann::json& metrics) const {

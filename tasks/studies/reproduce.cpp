@@ -8,8 +8,8 @@
 #include <mutex>
 #include <thread>
 
+#include "nn/atomic_file.h"
 #include "tasks/experiments/registry.h"
-#include "tasks/report/atomic_file.h"
 #include "tasks/report/reversibility_table.h"
 #include "tasks/report/table1.h"
 #include "tasks/run.h"
@@ -160,8 +160,8 @@ json reproduce(const ReproduceOptions& o) {
   const double wall =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const json table = table_of(runs, results, o.seeds);
-  write_file_atomic(o.out / "table1.json", table.dump(2) + "\n");
-  write_file_atomic(o.out / "table1.md", table1_markdown(table, wall, table_notes(tasks)));
+  nn::write_file_atomic(o.out / "table1.json", table.dump(2) + "\n");
+  nn::write_file_atomic(o.out / "table1.md", table1_markdown(table, wall, table_notes(tasks)));
   // What the HNN makes possible: the tasks' comparison figures, and reversibility on every run.
   for (const std::string& task : tasks) {
     if (!make_task(task)->has_comparison()) continue;
@@ -182,8 +182,8 @@ json reversibility_report(const fs::path& results, const ReversibilityOptions& o
       if (fs::exists(dir / "metrics.json")) rows.push_back(reversibility(dir, options));
     }
   }
-  write_file_atomic(results / "reversibility.json", rows.dump(2) + "\n");
-  write_file_atomic(results / "reversibility.md", reversibility_markdown(rows));
+  nn::write_file_atomic(results / "reversibility.json", rows.dump(2) + "\n");
+  nn::write_file_atomic(results / "reversibility.md", reversibility_markdown(rows));
   return rows;
 }
 

@@ -6,10 +6,11 @@
 #include <cmath>
 #include <fstream>
 
-#include "nn/checkpoint.h"
+#include "nn/atomic_file.h"
+#include "nn/parameter_file.h"
 #include "tasks/error.h"
-#include "tasks/report/atomic_file.h"
 #include "tasks/report/json_values.h"
+#include "tasks/train/stop.h"
 
 namespace hnn::tasks {
 
@@ -41,19 +42,6 @@ std::vector<nn::NamedParameter<T>> matrices(const nn::Module<T>& model,
 template <typename T>
 std::string matrices_kind(const nn::Module<T>& model) {
   return "train-checkpoint+adam:" + model.kind();
-}
-
-// Every group's moments end to end: the groups list the model's parameters in order.
-template <typename T>
-nn::AdamState<T> joined_state(std::span<const nn::Adam<T>> adams) {
-  nn::AdamState<T> all;
-  for (const nn::Adam<T>& adam : adams) {
-    nn::AdamState<T> s = adam.state();
-    all.steps = s.steps;
-    all.m.insert(all.m.end(), s.m.begin(), s.m.end());
-    all.v.insert(all.v.end(), s.v.begin(), s.v.end());
-  }
-  return all;
 }
 
 json to_json(const TrainState& s) {
@@ -104,14 +92,14 @@ TrainState from_json(const json& j) {
 }  // namespace
 
 template <typename T>
-void save_train_checkpoint(const fs::path& dir, const nn::Module<T>& model,
-                           std::span<const nn::Adam<T>> adams, TrainState state) {
+void save_train_checkpoint(const fs::path& dir, const nn::Module<T>& model, const nn::Adam<T>& adam,
+                           TrainState state) {
   fs::create_directories(dir);
   state.params_file = fmt::format("step-{:09d}.bin", state.step);
-  const nn::AdamState<T> moments = joined_state(adams);
+  const nn::AdamState<T> moments = adam.state();
   nn::save_parameters(dir / state.params_file, matrices_kind(model),
                       matrices(model, moments.m, moments.v));
-  write_file_atomic(dir / kStateFile, to_json(state).dump() + "\n");
+  nn::write_file_atomic(dir / kStateFile, to_json(state).dump() + "\n");
   for (const fs::directory_entry& entry : fs::directory_iterator(dir)) {
     const std::string name = entry.path().filename().string();
     if (name != kStateFile && name != state.params_file) fs::remove_all(entry.path());
@@ -134,32 +122,81 @@ TrainState read_train_state(const fs::path& dir) {
 
 template <typename T>
 void load_train_checkpoint(const fs::path& dir, const TrainState& state, nn::Module<T>& model,
-                           std::span<nn::Adam<T>> adams) {
-  nn::AdamState<T> moments = joined_state<T>(adams);
+                           nn::Adam<T>& adam) {
+  nn::AdamState<T> moments = adam.state();
   std::vector<nn::NamedParameter<T>> list = matrices(model, moments.m, moments.v);
   nn::load_parameters(dir / state.params_file, matrices_kind(model), list);
   // The moment leaves were filled by the load; the model's own leaves are list[0, n).
   const std::size_t n = moments.m.size();
-  std::size_t first = 0;
-  for (nn::Adam<T>& adam : adams) {
-    nn::AdamState<T> group = adam.state();
-    for (std::size_t i = 0; i < group.m.size(); ++i) {
-      group.m[i] = list[n + first + i].var.value();
-      group.v[i] = list[2 * n + first + i].var.value();
-    }
-    first += group.m.size();
-    group.steps = state.step;
-    adam.load_state(std::move(group));
+  for (std::size_t i = 0; i < n; ++i) {
+    moments.m[i] = list[n + i].var.value();
+    moments.v[i] = list[2 * n + i].var.value();
   }
+  moments.steps = state.step;
+  adam.load_state(std::move(moments));
+}
+
+template <typename T>
+RunCheckpoints<T>::RunCheckpoints(fs::path dir, long every, long total_steps, json run,
+                                  std::uint64_t data_hash)
+    : dir_(std::move(dir)),
+      every_(every > 0 ? every : std::max(1L, total_steps / 10)),
+      total_steps_(total_steps),
+      run_(std::move(run)),
+      data_hash_(data_hash) {}
+
+template <typename T>
+void RunCheckpoints<T>::save(long step, Objective<T>& objective, const nn::Adam<T>& adam,
+                             const std::vector<CurvePoint>& curve, double seconds) {
+  for (const ad::Var<T>& p : adam.parameters()) {
+    if (!p.value().allFinite()) {
+      throw TrainingDiverged(
+          fmt::format("training diverged at step {}: the parameters are not finite{}", step,
+                      last_good()),
+          step);
+    }
+  }
+  TrainState state{.step = step,
+                   .total_steps = total_steps_,
+                   .sampler_state = objective.sampler().state(),
+                   .data_hash = data_hash_,
+                   .curve = curve,
+                   .seconds = seconds,
+                   .run = run_};
+  save_train_checkpoint<T>(dir_, objective.model(), adam, std::move(state));
+  last_saved_ = step;
+}
+
+template <typename T>
+TrainState RunCheckpoints<T>::restore(Objective<T>& objective, nn::Adam<T>& adam) {
+  TrainState state = read_train_state(dir_);
+  HNN_TASKS_CHECK(state.total_steps == total_steps_,
+                  "the checkpoint in '{}' is of a run of {} steps, not {}", dir_.string(),
+                  state.total_steps, total_steps_);
+  HNN_TASKS_CHECK(state.data_hash == data_hash_,
+                  "the training data differ from those of the checkpoint in '{}'", dir_.string());
+  load_train_checkpoint<T>(dir_, state, objective.model(), adam);
+  objective.sampler().set_state(state.sampler_state);
+  last_saved_ = state.step;
+  return state;
+}
+
+template <typename T>
+std::string RunCheckpoints<T>::last_good() const {
+  return last_saved_ > 0 ? fmt::format("; the last good checkpoint (step {}) is kept in {}",
+                                       last_saved_, dir_.string())
+                         : "";
 }
 
 template void save_train_checkpoint(const fs::path&, const nn::Module<float>&,
-                                    std::span<const nn::Adam<float>>, TrainState);
+                                    const nn::Adam<float>&, TrainState);
 template void save_train_checkpoint(const fs::path&, const nn::Module<double>&,
-                                    std::span<const nn::Adam<double>>, TrainState);
+                                    const nn::Adam<double>&, TrainState);
 template void load_train_checkpoint(const fs::path&, const TrainState&, nn::Module<float>&,
-                                    std::span<nn::Adam<float>>);
+                                    nn::Adam<float>&);
 template void load_train_checkpoint(const fs::path&, const TrainState&, nn::Module<double>&,
-                                    std::span<nn::Adam<double>>);
+                                    nn::Adam<double>&);
+template class RunCheckpoints<float>;
+template class RunCheckpoints<double>;
 
 }  // namespace hnn::tasks

@@ -19,7 +19,7 @@ class FieldObjective : public Objective<T> {
                  const nn::AdamOptions& adam, std::uint64_t seed);
 
   nn::Module<T>& model() override { return model_; }
-  std::vector<ParameterGroup<T>> parameter_groups() const override {
+  std::vector<nn::AdamGroup<T>> parameter_groups() const override {
     return {{model_.parameters(), adam_}};
   }
   RowSampler& sampler() override { return sampler_; }

@@ -21,50 +21,19 @@ long record_interval(const LoopOptions& o) {
   return o.record_every > 0 ? o.record_every : std::max(1L, o.steps / 100);
 }
 
-// An Adam per parameter group, each stepped with its slice of the gradients of all parameters.
+// Each group's options as the loop needs them: a positive learning rate (a schedule scales it)
+// and a finite weight decay.
 template <typename T>
-class GroupedAdam {
- public:
-  explicit GroupedAdam(const std::vector<ParameterGroup<T>>& groups) {
-    adams_.reserve(groups.size());  // no reallocation: the Adams stay where they are built
-    for (const ParameterGroup<T>& group : groups) {
-      check(group.adam);
-      adams_.emplace_back(group.parameters, group.adam);
-      base_lr_.push_back(group.adam.lr);
-      slices_.emplace_back().reserve(group.parameters.size());
-      all_.insert(all_.end(), group.parameters.begin(), group.parameters.end());
-    }
-  }
-  const std::vector<ad::Var<T>>& parameters() const { return all_; }
-  std::vector<nn::Adam<T>>& adams() { return adams_; }
-  /// Each group's learning rate becomes its configured one times `factor`.
-  void scale_lr(double factor) {
-    for (std::size_t i = 0; i < adams_.size(); ++i) adams_[i].set_lr(base_lr_[i] * factor);
-  }
-
-  static void check(const nn::AdamOptions& o) {
+std::vector<nn::AdamGroup<T>> checked(std::vector<nn::AdamGroup<T>> groups) {
+  for (const nn::AdamGroup<T>& group : groups) {
+    const nn::AdamOptions& o = group.options;
     HNN_TASKS_CHECK(o.lr > 0 && std::isfinite(o.lr), "learning rate must be positive, got {}",
                     o.lr);
     HNN_TASKS_CHECK(o.weight_decay >= 0 && std::isfinite(o.weight_decay),
                     "weight decay must be a finite number >= 0, got {}", o.weight_decay);
   }
-
-  void step(const std::vector<ad::Var<T>>& grads) {
-    auto first = grads.begin();
-    for (std::size_t i = 0; i < adams_.size(); ++i) {
-      const auto count = std::ptrdiff_t(adams_[i].parameters().size());
-      slices_[i].assign(first, first + count);  // within capacity: no allocation
-      adams_[i].step(slices_[i]);
-      first += count;
-    }
-  }
-
- private:
-  std::vector<nn::Adam<T>> adams_;
-  std::vector<double> base_lr_;
-  std::vector<std::vector<ad::Var<T>>> slices_;
-  std::vector<ad::Var<T>> all_;
-};
+  return groups;
+}
 
 // The groups must cover the model's parameters in order: checkpoints name Adam's moments after
 // them.
@@ -78,68 +47,6 @@ void check_groups(Objective<T>& objective, const std::vector<ad::Var<T>>& groupe
                   "the objective's parameter groups do not list the model's parameters in "
                   "order");
 }
-
-// The checkpoints of one run (LoopOptions::checkpoint_dir): when they are due, writing them and
-// restoring from one.
-template <typename T>
-class Checkpoints {
- public:
-  Checkpoints(const LoopOptions& o, std::uint64_t data_hash)
-      : o_(o),
-        every_(o.checkpoint_every > 0 ? o.checkpoint_every : std::max(1L, o.steps / 10)),
-        data_hash_(data_hash) {}
-
-  bool enabled() const { return !o_.checkpoint_dir.empty(); }
-  bool due(long step) const { return enabled() && (step % every_ == 0 || step == o_.steps); }
-
-  void save(long step, Objective<T>& objective, GroupedAdam<T>& adam, const TrainResult& so_far) {
-    // A checkpoint holds finite parameters only: "the last good checkpoint" stays good.
-    for (const ad::Var<T>& p : adam.parameters()) {
-      if (!p.value().allFinite()) {
-        throw TrainingDiverged(
-            fmt::format("training diverged at step {}: the parameters are not finite{}", step,
-                        where()),
-            step);
-      }
-    }
-    TrainState state{.step = step,
-                     .total_steps = o_.steps,
-                     .sampler_state = objective.sampler().state(),
-                     .data_hash = data_hash_,
-                     .curve = so_far.curve,
-                     .seconds = so_far.seconds,
-                     .run = o_.run_settings};
-    save_train_checkpoint<T>(o_.checkpoint_dir, objective.model(), adam.adams(), std::move(state));
-    last_saved_ = step;
-  }
-
-  /// Loads the checkpoint into the model, the optimisers and the sampler; returns its state.
-  TrainState restore(Objective<T>& objective, GroupedAdam<T>& adam) {
-    const std::string dir = o_.checkpoint_dir.string();
-    TrainState state = read_train_state(o_.checkpoint_dir);
-    HNN_TASKS_CHECK(state.total_steps == o_.steps,
-                    "the checkpoint in '{}' is of a run of {} steps, not {}", dir,
-                    state.total_steps, o_.steps);
-    HNN_TASKS_CHECK(state.data_hash == data_hash_,
-                    "the training data differ from those of the checkpoint in '{}'", dir);
-    load_train_checkpoint<T>(o_.checkpoint_dir, state, objective.model(), adam.adams());
-    objective.sampler().set_state(state.sampler_state);
-    last_saved_ = state.step;
-    return state;
-  }
-
-  std::string where() const {
-    return last_saved_ > 0 ? fmt::format("; the last good checkpoint (step {}) is kept in {}",
-                                         last_saved_, o_.checkpoint_dir.string())
-                           : "";
-  }
-
- private:
-  const LoopOptions& o_;
-  long every_;
-  std::uint64_t data_hash_;
-  long last_saved_ = 0;
-};
 
 // Arms a StopSignal for the lifetime of a training loop.
 class ArmStop {
@@ -178,9 +85,9 @@ class TrainClock {
   std::chrono::duration<double> paused_{0};
 };
 
-// One step: the batch's loss, its gradients and the optimisers' update. Returns the loss.
+// One step: the batch's loss, its gradients and the optimiser's update. Returns the loss.
 template <typename T>
-double train_step(long step, Objective<T>& objective, GroupedAdam<T>& adam,
+double train_step(long step, Objective<T>& objective, nn::Adam<T>& adam,
                   std::vector<ad::Var<T>>& grads, const std::string& where) {
   ad::TapeScope scope;  // everything this step records is recycled at the closing brace
   objective.sampler().next();
@@ -195,16 +102,18 @@ double train_step(long step, Objective<T>& objective, GroupedAdam<T>& adam,
   return value;
 }
 
-// One run of the loop: the optimisers, the checkpoints, the loss curve so far and the clock.
+// One run of the loop: the optimiser, the checkpoints, the loss curve so far and the clock.
 template <typename T>
 class Loop {
  public:
   Loop(Objective<T>& objective, const LoopOptions& o)
       : objective_(objective),
         o_(o),
-        adam_(objective.parameter_groups()),
-        checkpoints_(o, objective.data_fingerprint()) {
+        adam_(checked(objective.parameter_groups())),
+        checkpoints_(o.checkpoint_dir, o.checkpoint_every, o.steps, o.run_settings,
+                     objective.data_fingerprint()) {
     check_groups(objective, adam_.parameters());
+    for (std::size_t g = 0; g < adam_.group_count(); ++g) base_lr_.push_back(adam_.options(g).lr);
   }
 
   /// The first step to take: 1, or the one after the checkpoint when resuming.
@@ -222,9 +131,11 @@ class Loop {
   }
 
   double step(long step) {
-    if (o_.lr_schedule != LrSchedule::kConstant)
-      adam_.scale_lr(lr_factor(o_.lr_schedule, step, o_.steps));
-    return train_step(step, objective_, adam_, grads_, checkpoints_.where());
+    if (o_.lr_schedule != LrSchedule::kConstant) {
+      const double factor = lr_factor(o_.lr_schedule, step, o_.steps);
+      for (std::size_t g = 0; g < base_lr_.size(); ++g) adam_.set_lr(g, base_lr_[g] * factor);
+    }
+    return train_step(step, objective_, adam_, grads_, checkpoints_.last_good());
   }
 
   void record(long step, double loss) {
@@ -238,7 +149,8 @@ class Loop {
   void checkpoint(long step, bool stopping) {
     if (!checkpoints_.due(step) && !(stopping && checkpoints_.enabled())) return;
     result_.seconds = clock_.seconds();
-    clock_.pause_for([&] { checkpoints_.save(step, objective_, adam_, result_); });
+    clock_.pause_for(
+        [&] { checkpoints_.save(step, objective_, adam_, result_.curve, result_.seconds); });
   }
 
   [[noreturn]] void stopped(long step) const {
@@ -257,8 +169,9 @@ class Loop {
  private:
   Objective<T>& objective_;
   const LoopOptions& o_;
-  GroupedAdam<T> adam_;
-  Checkpoints<T> checkpoints_;
+  nn::Adam<T> adam_;
+  std::vector<double> base_lr_;  // each group's configured rate, which a schedule scales
+  RunCheckpoints<T> checkpoints_;
   const long interval_ = record_interval(o_);
   TrainResult result_;
   TrainClock clock_{0};

@@ -1,18 +1,18 @@
 #pragma once
-// The one training loop of every task: Adam per parameter group on an Objective's batch loss,
-// the loss curve at intervals, checkpoints, resume from a checkpoint, and stop on request.
+// The one training loop of every task: Adam with the Objective's parameter groups on its batch
+// loss, the loss curve at intervals, checkpoints (train/checkpoint.h), resume from a checkpoint,
+// and stop on request (train/stop.h).
 
-#include <atomic>
 #include <filesystem>
 #include <functional>
 #include <nlohmann/json.hpp>
-#include <stdexcept>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include "tasks/report/run_folder.h"
 #include "tasks/train/objective.h"
+#include "tasks/train/stop.h"
 
 namespace hnn::tasks {
 
@@ -20,36 +20,6 @@ struct TrainResult {
   std::vector<CurvePoint> curve{};
   double seconds = 0;  // the training steps only (no data, no loss-curve points, no evaluation)
   long steps = 0;
-};
-
-/// Training stopped because the loss became NaN or infinite.
-class TrainingDiverged : public std::runtime_error {
- public:
-  TrainingDiverged(const std::string& message, long step)
-      : std::runtime_error(message), step_(step) {}
-  long step() const { return step_; }
-
- private:
-  long step_;
-};
-
-/// Training stopped on request (StopSignal) after `step()`, with a checkpoint written.
-class TrainingInterrupted : public std::runtime_error {
- public:
-  TrainingInterrupted(const std::string& message, long step)
-      : std::runtime_error(message), step_(step) {}
-  long step() const { return step_; }
-
- private:
-  long step_;
-};
-
-/// Asks a training loop to stop after its current step. Set from a signal handler, so it holds
-/// lock-free atomics only. `armed` is true while a loop polls `requested`: a handler can fall
-/// back to the signal's default action when nothing would.
-struct StopSignal {
-  std::atomic<bool> armed{false};
-  std::atomic<bool> requested{false};
 };
 
 /// How the learning rate moves over a run: constant, or cosine decay from the set rate at step

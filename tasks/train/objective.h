@@ -16,19 +16,14 @@
 namespace hnn::tasks {
 
 template <typename T>
-struct ParameterGroup {
-  std::vector<ad::Var<T>> parameters;
-  nn::AdamOptions adam;
-};
-
-template <typename T>
 class Objective {
  public:
   virtual ~Objective() = default;
   /// The model trained (its parameters and the optimisers' moments make a checkpoint).
   virtual nn::Module<T>& model() = 0;
-  /// The groups, in order, list model().parameters() in its order.
-  virtual std::vector<ParameterGroup<T>> parameter_groups() const = 0;
+  /// The groups of nn::Adam, each with its own settings; in order, they list
+  /// model().parameters() in its order.
+  virtual std::vector<nn::AdamGroup<T>> parameter_groups() const = 0;
   virtual RowSampler& sampler() = 0;
   /// The mean loss over the sampler's current batch, on the graph.
   virtual ad::Var<T> batch_loss() = 0;

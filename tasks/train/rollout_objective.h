@@ -67,7 +67,7 @@ class RolloutObjective : public Objective<T> {
                    RolloutIntegrator integrator = RolloutIntegrator::kRk4, int substeps = 1);
 
   nn::Module<T>& model() override { return model_; }
-  std::vector<ParameterGroup<T>> parameter_groups() const override {
+  std::vector<nn::AdamGroup<T>> parameter_groups() const override {
     return {{model_.parameters(), adam_}};
   }
   RowSampler& sampler() override { return sampler_; }

@@ -1,4 +1,5 @@
-// Adam and SGD against hand-computed steps, their argument checks, and no allocation per step.
+// Adam (with parameter groups) and SGD against hand-computed steps, their argument checks, and
+// no allocation per step.
 
 #include <gtest/gtest.h>
 
@@ -240,4 +241,60 @@ TEST(Adam, LoadStateRefusesAnotherShapeAndChangesNothing) {
   state = adam.state();
   state.steps = -1;
   EXPECT_THROW(adam.load_state(state), std::invalid_argument);
+}
+
+TEST(Adam, TwoGroupsStepAsTwoAdamsWithTheirOwnOptions) {
+  // torch.optim.Adam(param_groups): each group is updated with its own options, bit for bit as
+  // an Adam of its own would, and the groups share the step count.
+  const auto leaf = [](const MatrixD& m) { return Var<double>::leaf(m); };
+  const MatrixD a0{{1.0, -2.0}}, b0{{0.5}, {3.0}}, c0{{-1.5}};
+  const Var<double> a = leaf(a0), b = leaf(b0), c = leaf(c0);
+  const Var<double> a1 = leaf(a0), b1 = leaf(b0), c1 = leaf(c0);
+  const nn::AdamOptions first{.lr = 0.1, .weight_decay = 0.01};
+  const nn::AdamOptions second{.lr = 0.02, .beta1 = 0.8, .eps = 1e-6};
+  nn::Adam<double> grouped({{{a, b}, first}, {{c}, second}});
+  nn::Adam<double> alone_first({a1, b1}, first);
+  nn::Adam<double> alone_second({c1}, second);
+  ASSERT_EQ(grouped.group_count(), 2u);
+  EXPECT_EQ(grouped.options(1).beta1, 0.8);
+  ASSERT_EQ(grouped.parameters().size(), 3u);
+  EXPECT_EQ(&grouped.parameters()[2].value(), &c.value());
+  for (int t = 0; t < 4; ++t) {
+    if (t == 2) {  // a schedule's step: one group's rate, then every group's
+      grouped.set_lr(1, 0.05);
+      alone_second.set_lr(0.05);
+    }
+    if (t == 3) {
+      grouped.set_lr(0.03);
+      alone_first.set_lr(0.03);
+      alone_second.set_lr(0.03);
+    }
+    const double s = std::sin(t + 1.0);
+    const Var<double> ga = row({s, -2 * s}), gb = leaf(MatrixD{{s * s}, {-s}}), gc = row({1 - s});
+    grouped.step({ga, gb, gc});
+    alone_first.step({ga, gb});
+    alone_second.step({gc});
+  }
+  EXPECT_EQ(grouped.step_count(), 4);
+  EXPECT_EQ(grouped.lr(), 0.03);
+  EXPECT_EQ(a.value(), a1.value());
+  EXPECT_EQ(b.value(), b1.value());
+  EXPECT_EQ(c.value(), c1.value());
+  EXPECT_EQ(grouped.second_moment(1), alone_first.second_moment(1));
+  EXPECT_EQ(grouped.first_moment(2), alone_second.first_moment(0));
+  // The weight decay of the first group only: the second moved as without it.
+  EXPECT_NE(a.value(), a0);
+}
+
+TEST(Adam, GroupsAreCheckedNamingTheGroup) {
+  const Var<double> a = Var<double>::leaf(MatrixD{{1.0}}), b = Var<double>::leaf(MatrixD{{2.0}});
+  EXPECT_THROW(nn::Adam<double>(std::vector<nn::AdamGroup<double>>{}), std::invalid_argument);
+  try {
+    nn::Adam<double>({{{a}, {}}, {{b}, {.lr = -1}}});
+    ADD_FAILURE() << "a negative learning rate was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_STREQ(e.what(), "Adam group 1: lr must be >= 0, got -1");
+  }
+  // One parameter in two groups would be updated twice a step.
+  EXPECT_THROW(nn::Adam<double>({{{a}, {}}, {{b, a}, {}}}), std::invalid_argument);
 }

@@ -9,8 +9,8 @@
 #include <limits>
 #include <map>
 
-#include "nn/checkpoint.h"
 #include "nn/hnn.h"
+#include "nn/parameter_file.h"
 #include "reliability_util.h"
 #include "tasks/experiments/registry.h"
 #include "tasks/field/field_model_run.h"
@@ -124,11 +124,11 @@ TEST_F(CheckpointFiles, EveryBadCheckpointIsOneLineAndChangesNoFile) {
          const fs::path bin = run / "checkpoint" / "step-000000020.bin";
          write_text(bin, read_text(bin).substr(0, 100));
        },
-       "checkpoint 'RUN/checkpoint/step-000000020.bin': truncated: parameter "
+       "parameter file 'RUN/checkpoint/step-000000020.bin': truncated: parameter "
        "'model/mlp.layers.0.weight' is 2x8 but only 1 bytes remain at offset 99"},
       {"missing-bin",
        [](const fs::path& run) { fs::remove(run / "checkpoint" / "step-000000020.bin"); },
-       "checkpoint 'RUN/checkpoint/step-000000020.bin': cannot open for reading: No such file "
+       "parameter file 'RUN/checkpoint/step-000000020.bin': cannot open for reading: No such file "
        "or directory"},
   };
   for (const Case& c : cases) {
@@ -280,7 +280,7 @@ TEST(Divergence, BetweenCheckpointsKeepsTheEarlierOneIntact) {
             read_text(dir / "reference" / tasks::read_train_state(dir / "reference").params_file));
   SpringRun loaded = spring_run();
   nn::Adam<double> adam(loaded.model->parameters());
-  tasks::load_train_checkpoint<double>(ckpt, state, *loaded.model, std::span(&adam, 1));
+  tasks::load_train_checkpoint<double>(ckpt, state, *loaded.model, adam);
   for (const auto& p : loaded.model->parameters()) EXPECT_TRUE(p.value().allFinite());
 }
 

@@ -6,8 +6,8 @@
 
 #include <csignal>
 
-#include "nn/checkpoint.h"
 #include "nn/hnn.h"
+#include "nn/parameter_file.h"
 #include "reliability_util.h"
 #include "tasks/experiments/registry.h"
 #include "tasks/field/field_model_run.h"
@@ -109,7 +109,7 @@ TEST(Resume, RefusesACorruptCheckpointAndChangesNothing) {
   const fs::path bin = dir / "checkpoint" / state.params_file;
   const std::string bytes = read_text(bin);
   write_text(bin, bytes.substr(0, bytes.size() / 2));
-  EXPECT_THROW(train_spring<double>(25, 0, dir / "checkpoint", true), nn::CheckpointError);
+  EXPECT_THROW(train_spring<double>(25, 0, dir / "checkpoint", true), nn::ParameterFileError);
   write_text(bin, bytes);
   const std::string json = read_text(dir / "checkpoint" / "state.json");
   write_text(dir / "checkpoint" / "state.json", json.substr(0, json.size() / 2));
@@ -205,14 +205,14 @@ void expect_complete_files(const fs::path& run) {
   std::mt19937_64 rng(0);
   const auto model = nn::make_model<double>(config, rng);
   nn::Adam<double> adam(model->parameters());
-  tasks::load_train_checkpoint<double>(checkpoint_dir(run), state, *model, std::span(&adam, 1));
+  tasks::load_train_checkpoint<double>(checkpoint_dir(run), state, *model, adam);
   EXPECT_EQ(adam.step_count(), state.step);
   for (const auto& entry : fs::recursive_directory_iterator(run)) {
     const std::string name = entry.path().filename().string();
     if (entry.is_directory() || name == "state.json" || name == state.params_file) continue;
     if (name.find(".tmp") != std::string::npos) continue;
     EXPECT_TRUE(name.starts_with("step-")) << "unexpected file " << entry.path();
-    EXPECT_NO_THROW(nn::read_checkpoint_info(entry.path())) << entry.path();
+    EXPECT_NO_THROW(nn::read_parameter_file_info(entry.path())) << entry.path();
   }
 }
 

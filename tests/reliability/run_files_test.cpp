@@ -6,8 +6,8 @@
 
 #include <random>
 
-#include "nn/checkpoint.h"
 #include "nn/hnn.h"
+#include "nn/parameter_file.h"
 #include "reliability_util.h"
 
 namespace hnn::reliability {
@@ -58,7 +58,7 @@ TEST_F(RunFiles, BadParameterFilesAreRefusedByEvaluateAndRollout) {
   struct Case {
     std::string name;
     std::function<void(const fs::path&)> edit;
-    std::string reason;  // after "checkpoint 'RUN/params.bin': "
+    std::string reason;  // after "parameter file 'RUN/params.bin': "
   };
   const std::vector<Case> cases = {
       {"empty", [](const fs::path& r) { truncate_to(r / "params.bin", 0); },
@@ -105,7 +105,7 @@ TEST_F(RunFiles, BadParameterFilesAreRefusedByEvaluateAndRollout) {
   for (const Case& c : cases) {
     const fs::path run = variant(c.name, c.edit);
     const std::string line =
-        "hnn: error: checkpoint '" + (run / "params.bin").string() + "': " + c.reason + "\n";
+        "hnn: error: parameter file '" + (run / "params.bin").string() + "': " + c.reason + "\n";
     for (const char* command : {"evaluate", "rollout"}) {
       const Result r = run_hnn({command, run.string()}, dir_.path());
       EXPECT_EQ(r.code, 1) << c.name << " " << command;
@@ -176,7 +176,7 @@ TEST_F(RunFiles, UnknownIntegratorWritesNothing) {
   EXPECT_FALSE(fs::exists(run / "rollout_rk5.csv"));
 }
 
-// The reader itself, on every prefix of a file and on single-bit flips: always a CheckpointError
+// The reader itself, on every prefix of a file and on single-bit flips: always a ParameterFileError
 // naming the file, and the model untouched.
 TEST(ParameterReader, EveryTruncationAndBitFlipIsRefusedWithoutChangingTheModel) {
   const TempDir dir;
@@ -192,11 +192,11 @@ TEST(ParameterReader, EveryTruncationAndBitFlipIsRefusedWithoutChangingTheModel)
   std::vector<nn::Matrix<double>> values;
   for (const auto& p : before) values.push_back(p.value());
   const auto expect_refused = [&](const std::string& what) {
-    EXPECT_THROW(nn::read_checkpoint_info(bad), nn::CheckpointError) << what;
+    EXPECT_THROW(nn::read_parameter_file_info(bad), nn::ParameterFileError) << what;
     try {
       nn::load_parameters(bad, *target);
       ADD_FAILURE() << what << ": loaded";
-    } catch (const nn::CheckpointError& e) {
+    } catch (const nn::ParameterFileError& e) {
       EXPECT_EQ(e.path(), bad) << what;
     }
     for (std::size_t i = 0; i < before.size(); ++i) ASSERT_EQ(before[i].value(), values[i]) << what;

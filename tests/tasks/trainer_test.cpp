@@ -6,8 +6,8 @@
 #include <cmath>
 #include <limits>
 
-#include "nn/checkpoint.h"
 #include "nn/hnn.h"
+#include "nn/parameter_file.h"
 #include "tasks/evaluate/rollouts.h"
 #include "tasks/experiments/registry.h"
 #include "tasks/field/field_model_run.h"

@@ -6,7 +6,8 @@
 #include <fmt/format.h>
 
 #include "apps/hnn/commands/commands.h"
-#include "tasks/report/atomic_file.h"
+#include "nn/atomic_file.h"
+#include "nn/export.h"
 #include "tasks/run.h"
 
 namespace hnn::app {
@@ -25,7 +26,7 @@ void run_export(const ExportOptions& o) {
   const nn::DynamicsModel<double>& model = *in_data_units;
   const std::string source =
       fmt::format("run {} (task {}, seed {})", o.run, loaded.task->name(), loaded.settings.seed);
-  tasks::write_file_atomic(o.out, nn::export_model(model, format, source));
+  nn::write_file_atomic(o.out, nn::export_model(model, format, source));
   fmt::print("hnn export: {} as {} -> {}\n", model.describe(), o.format, o.out);
 }
 

@@ -10,8 +10,8 @@
 
 #include "apps/hnn/commands/commands.h"
 #include "apps/hnn/commands/validators.h"
+#include "nn/atomic_file.h"
 #include "physics/expression_system.h"
-#include "tasks/report/atomic_file.h"
 
 namespace hnn::app {
 
@@ -123,7 +123,7 @@ void simulate(const SimulateOptions& o) {
     std::normal_distribution<double> normal(0.0, o.noise);
     for (Eigen::Index i = 0; i < x.size(); ++i) x.data()[i] += normal(rng);
   }
-  tasks::write_file_atomic(o.out, csv(system, x, dxdt, o));
+  nn::write_file_atomic(o.out, csv(system, x, dxdt, o));
   fmt::print("hnn simulate: {} trajectories x {} points of {} ({}{}) -> {}\n", o.trajectories,
              o.points, system.name(), o.integrator,
              system.separable() ? ", separable" : ", not separable", o.out);

@@ -17,7 +17,7 @@
 #include <stdexcept>
 
 #include "apps/hnn/commands/validators.h"
-#include "tasks/report/atomic_file.h"
+#include "nn/atomic_file.h"
 
 namespace hnn::app::sweep {
 
@@ -191,7 +191,7 @@ void launch(const SweepPlan& plan, const LaunchOptions& o, const fs::path& out,
   const fs::path plan_file = out / "plan.json";
   json document = plan_json(plan, o, out, spec, program);
   if (extra.is_object()) document.update(extra);
-  tasks::write_file_atomic(plan_file, document.dump(1) + "\n");
+  nn::write_file_atomic(plan_file, document.dump(1) + "\n");
   become_driver(mode, plan_file);
 }
 

@@ -1,4 +1,4 @@
-// Checkpoints: bit-exact round trips, atomic writes, and clear refusals of files that do not fit.
+// Parameter files: bit-exact round trips, atomic writes, and clear refusals of misfits.
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -17,11 +17,11 @@ using nn::testing::small_config;
 
 namespace {
 
-class Checkpoint : public ::testing::Test {
+class ParameterFile : public ::testing::Test {
  protected:
   void SetUp() override {
     dir_ = fs::temp_directory_path() /
-           ("hnn_nn_checkpoint_test_" + std::to_string(::getpid()) + "_" +
+           ("hnn_nn_parameter_file_test_" + std::to_string(::getpid()) + "_" +
             ::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::remove_all(dir_);
     fs::create_directories(dir_);
@@ -51,13 +51,13 @@ void write_bytes(const fs::path& path, const std::string& bytes) {
   out.write(bytes.data(), std::streamsize(bytes.size()));
 }
 
-// Runs f, which must throw CheckpointError naming `path` with `reason` in its message.
+// Runs f, which must throw ParameterFileError naming `path` with `reason` in its message.
 template <typename F>
 void expect_refusal(F f, const fs::path& path, const std::string& reason) {
   try {
     f();
     ADD_FAILURE() << "no error; expected '" << reason << "'";
-  } catch (const nn::CheckpointError& e) {
+  } catch (const nn::ParameterFileError& e) {
     const std::string what = e.what();
     EXPECT_NE(what.find(path.string()), std::string::npos) << what;
     EXPECT_NE(what.find(reason), std::string::npos) << what;
@@ -74,7 +74,7 @@ std::vector<nn::Matrix<T>> values_of(const nn::Module<T>& m) {
 
 }  // namespace
 
-TEST_F(Checkpoint, SaveThenLoadReproducesPredictionsBitForBit) {
+TEST_F(ParameterFile, SaveThenLoadReproducesPredictionsBitForBit) {
   std::mt19937_64 rng(1), other(2);
   const MatrixD x = nn::random_normal<double>(16, 2, rng);
   for (const ModelKind kind : {ModelKind::kHnn, ModelKind::kBaseline}) {
@@ -96,12 +96,12 @@ TEST_F(Checkpoint, SaveThenLoadReproducesPredictionsBitForBit) {
   EXPECT_EQ(listing(), std::vector<std::string>{"model.bin"});
 }
 
-TEST_F(Checkpoint, InfoDescribesTheFile) {
+TEST_F(ParameterFile, InfoDescribesTheFile) {
   std::mt19937_64 rng(3);
   const nn::Hnn<double> hnn(small_config(ModelKind::kHnn, 4, {8, 8}), rng);
   nn::save_parameters(file("hnn.bin"), hnn);
-  const nn::CheckpointInfo info = nn::read_checkpoint_info(file("hnn.bin"));
-  EXPECT_EQ(info.version, nn::kCheckpointVersion);
+  const nn::ParameterFileInfo info = nn::read_parameter_file_info(file("hnn.bin"));
+  EXPECT_EQ(info.version, nn::kParameterFileVersion);
   EXPECT_EQ(info.scalar, nn::ScalarType::kFloat64);
   EXPECT_EQ(info.kind, "hnn:tanh");
   ASSERT_EQ(info.entries.size(), 5u);
@@ -112,7 +112,7 @@ TEST_F(Checkpoint, InfoDescribesTheFile) {
   EXPECT_EQ(info.entries[4].cols, 1);
 }
 
-TEST_F(Checkpoint, RefusesAMismatchedModelAndLeavesItUnchanged) {
+TEST_F(ParameterFile, RefusesAMismatchedModelAndLeavesItUnchanged) {
   std::mt19937_64 rng(4);
   const nn::Hnn<double> saved(small_config(ModelKind::kHnn, 2, {8, 8}), rng);
   nn::save_parameters(file("hnn.bin"), saved);
@@ -152,7 +152,7 @@ TEST_F(Checkpoint, RefusesAMismatchedModelAndLeavesItUnchanged) {
                  "holds float64 parameters but the model is float32");
 }
 
-TEST_F(Checkpoint, RefusesTruncatedCorruptAndForeignFiles) {
+TEST_F(ParameterFile, RefusesTruncatedCorruptAndForeignFiles) {
   std::mt19937_64 rng(5);
   nn::Hnn<double> model(small_config(ModelKind::kHnn, 2, {8}), rng);
   nn::save_parameters(file("good.bin"), model);
@@ -197,7 +197,7 @@ TEST_F(Checkpoint, RefusesTruncatedCorruptAndForeignFiles) {
   EXPECT_EQ(values_of(model), before);
 }
 
-TEST_F(Checkpoint, FailedSaveLeavesNoTemporaryFile) {
+TEST_F(ParameterFile, FailedSaveLeavesNoTemporaryFile) {
   std::mt19937_64 rng(6);
   const nn::Baseline<double> model(small_config(ModelKind::kBaseline, 2, {4}), rng);
   const fs::path nowhere = file("no/such/dir/model.bin");
@@ -205,7 +205,7 @@ TEST_F(Checkpoint, FailedSaveLeavesNoTemporaryFile) {
   EXPECT_TRUE(listing().empty());
 }
 
-TEST_F(Checkpoint, SavesSeveralModulesTogether) {
+TEST_F(ParameterFile, SavesSeveralModulesTogether) {
   // The pixel task saves an autoencoder and an HNN in one file, by explicit names and kind.
   std::mt19937_64 rng(7), other(8);
   nn::AutoencoderConfig config;

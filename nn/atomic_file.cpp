@@ -1,0 +1,67 @@
+#include "nn/atomic_file.h"
+
+#include <fcntl.h>
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cerrno>
+
+namespace hnn::nn {
+
+namespace fs = std::filesystem;
+
+FileWriteError::FileWriteError(std::error_code code, const fs::path& path, std::string step)
+    : std::system_error(code, fmt::format("cannot write '{}' ({})", path.string(), step)),
+      path_(path),
+      step_(std::move(step)) {}
+
+namespace {
+
+std::error_code last_error() { return {errno, std::generic_category()}; }
+
+// Creates a temporary file next to `path` that no other writer uses: the process id tells
+// processes apart and the counter threads and calls; O_EXCL skips a leftover of an earlier
+// process that had the same id. Returns the descriptor, or -1 with errno set.
+int create_temporary(const fs::path& path, fs::path& temp) {
+  static std::atomic<unsigned long> counter{0};
+  while (true) {
+    temp = path;
+    temp += fmt::format(".tmp.{}-{}", ::getpid(), counter++);
+    const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+    if (fd >= 0 || errno != EEXIST) return fd;
+  }
+}
+
+}  // namespace
+
+void write_file_atomic(const fs::path& path, std::string_view content) {
+  fs::path temp;
+  const int fd = create_temporary(path, temp);
+  if (fd < 0) throw FileWriteError(last_error(), path, "creating a temporary file");
+  const auto fail = [&](std::error_code code, const char* step, bool open) {
+    if (open) ::close(fd);
+    ::unlink(temp.c_str());
+    throw FileWriteError(code, path, step);
+  };
+  std::size_t written = 0;
+  while (written < content.size()) {
+    const ssize_t n = ::write(fd, content.data() + written, content.size() - written);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) fail(last_error(), "writing", true);
+    if (n == 0) fail(std::make_error_code(std::errc::io_error), "writing", true);
+    written += std::size_t(n);
+  }
+  if (::fsync(fd) != 0) fail(last_error(), "flushing to disk", true);
+  if (::close(fd) != 0) fail(last_error(), "closing", false);
+  if (::rename(temp.c_str(), path.c_str()) != 0) fail(last_error(), "renaming into place", false);
+  // Make the rename itself durable (best effort: some file systems refuse directory fsync).
+  const fs::path dir = path.has_parent_path() ? path.parent_path() : fs::path(".");
+  const int dir_fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (dir_fd >= 0) {
+    ::fsync(dir_fd);
+    ::close(dir_fd);
+  }
+}
+
+}  // namespace hnn::nn
