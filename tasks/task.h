@@ -1,8 +1,9 @@
 #pragma once
-// A task is one experiment: its defaults (the paper's settings) and how a run of it goes (the
-// paper's Table 1 row is in data/peers.json, tasks/studies/published.h). Every task, the pixel pendulum included, is registered by name (make_task) and
-// offers the same entry points through TaskRun: build the data, train, evaluate, save and load,
-// roll out. The flow of a run (tasks/run.h): task -> data -> train -> evaluate -> report.
+// A task is one experiment: its defaults (the paper's settings) and how a run of it goes (its
+// Table 1 row is in data/peers.json, read by tasks/studies/published.h). Every task, the pixel
+// pendulum included, is registered by name (make_task) and offers the same entry points through
+// TaskRun: build the data, train, evaluate, save and load, roll out. The flow of a run
+// (tasks/run.h): task -> data -> train -> evaluate -> report.
 
 #include <filesystem>
 #include <memory>

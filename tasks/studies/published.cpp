@@ -71,9 +71,10 @@ PaperRow paper_row(const json& published, const std::string& task, nn::ModelKind
                           p.value("se", json()).is_number() ? p["se"].get<double>() : NAN};
       }
     }
-    throw Error(fmt::format("the peers file has no entry of the HNN paper's Table 1 for {} {} {} "
-                            "(peer \"{}\")",
-                            task, family, metric, kHnnPaper));
+    throw Error(
+        fmt::format("the peers file has no entry of the HNN paper's Table 1 for {} {} {} "
+                    "(peer \"{}\")",
+                    task, family, metric, kHnnPaper));
   };
   return {value("train_loss"), value("test_loss"), value("energy_mse")};
 }

@@ -395,8 +395,8 @@ TEST(PixelTask, IsRegisteredWithThePapersRow) {
   const nlohmann::json published = read_published(published_path());
   EXPECT_DOUBLE_EQ(paper_row(published, kPixelPendulum, nn::ModelKind::kHnn).test_loss.mean,
                    1.8451e-4);
-  EXPECT_DOUBLE_EQ(
-      paper_row(published, kPixelPendulum, nn::ModelKind::kBaseline).energy_mse.mean, 9.2748e-3);
+  EXPECT_DOUBLE_EQ(paper_row(published, kPixelPendulum, nn::ModelKind::kBaseline).energy_mse.mean,
+                   9.2748e-3);
 }
 
 }  // namespace

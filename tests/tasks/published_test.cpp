@@ -16,6 +16,7 @@ namespace hnn::tasks {
 namespace {
 
 using nlohmann::json;
+using testing::TempDir;
 
 TEST(Published, TheHnnPapersTable1HasBothModelsOfEveryPaperTask) {
   const json published = read_published(published_path());
@@ -60,9 +61,9 @@ TEST(Published, ABadEntryIsOneLineNamingTheFileAndTheEntry) {
     read_published(file);
     FAIL() << "no error";
   } catch (const Error& e) {
-    EXPECT_EQ(std::string(e.what()),
-              "peers file " + file.string() + ": entry 1: 'task_defaults_only' must be true or "
-              "false");
+    EXPECT_EQ(std::string(e.what()), "peers file " + file.string() +
+                                         ": entry 1: 'task_defaults_only' must be true or "
+                                         "false");
   }
   EXPECT_THROW(read_published(dir / "none.json"), Error);
   // $HNN_PEERS names another file.
