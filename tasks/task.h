@@ -1,8 +1,9 @@
 #pragma once
-// A task is one experiment: its defaults (the paper's settings), its Table 1 row, and how a run
-// of it goes. Every task, the pixel pendulum included, is registered by name (make_task) and
-// offers the same entry points through TaskRun: build the data, train, evaluate, save and load,
-// roll out. The flow of a run (tasks/run.h): task -> data -> train -> evaluate -> report.
+// A task is one experiment: its defaults (the paper's settings) and how a run of it goes (its
+// Table 1 row is in data/peers.json, read by tasks/studies/published.h). Every task, the pixel
+// pendulum included, is registered by name (make_task) and offers the same entry points through
+// TaskRun: build the data, train, evaluate, save and load, roll out. The flow of a run
+// (tasks/run.h): task -> data -> train -> evaluate -> report.
 
 #include <filesystem>
 #include <memory>
@@ -18,14 +19,6 @@
 #include "tasks/train/loop.h"
 
 namespace hnn::tasks {
-
-/// One model's published numbers (reference implementation, Table 1): mean and standard error.
-struct PaperValue {
-  double mean = 0, se = 0;
-};
-struct PaperRow {
-  PaperValue train_loss, test_loss, energy_mse;
-};
 
 /// `hnn rollout`: the learned model's paths (and the truth's) from test states.
 struct RolloutRequest {
@@ -74,8 +67,6 @@ class Task {
   /// within the noise of the paper's widths (the model-size sweep, docs/speed_accuracy.md). By
   /// default the paper's widths (a task the sweep did not cover).
   virtual std::vector<int> lean_hidden() const { return train_config().hidden; }
-  /// The paper's Table 1 row of a model.
-  virtual PaperRow paper(nn::ModelKind model) const = 0;
   /// A paragraph under Table 1 when this task's metrics mean something particular.
   virtual std::string table_note() const { return ""; }
   /// A figure comparing a trained baseline run and a trained HNN run of this task into `out`,

@@ -29,9 +29,6 @@ class DampedSpringTask : public FieldTask {
   TrainConfig train_config() const override {
     return {.steps = 5000, .batch_size = 128, .learning_rate = 1e-3, .hidden = {256, 256}};
   }
-  PaperRow paper(nn::ModelKind) const override {
-    return {{NAN, NAN}, {NAN, NAN}, {NAN, NAN}};  // not in the HNN paper (docs: peers)
-  }
   std::string table_note() const override {
     return "Damped spring: energy is H = q^2 + p^2 of the conservative part, which the true "
            "flow dissipates; dhnn_paper_state_mse is the D-HNN paper's metric (one rollout from "

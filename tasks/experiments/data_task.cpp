@@ -308,9 +308,6 @@ class DataTask : public Task {
     return "your own trajectories: --data FILE (CSV, .npy, .npz, Schmidt & Lipson text)";
   }
   TrainConfig train_config() const override { return {}; }
-  PaperRow paper(nn::ModelKind) const override {
-    return {{NAN, NAN}, {NAN, NAN}, {NAN, NAN}};  // not one of the paper's tasks
-  }
   bool reads_data_file() const override { return true; }
   void check_task_settings(const json& settings) const override {
     for (const auto& [key, value] : settings.items()) {

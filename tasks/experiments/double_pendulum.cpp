@@ -38,9 +38,6 @@ class DoublePendulumTask : public FieldTask {
             .lr_schedule = LrSchedule::kCosine,
             .hidden = {128, 128}};
   }
-  PaperRow paper(nn::ModelKind) const override {
-    return {{NAN, NAN}, {NAN, NAN}, {NAN, NAN}};  // not in the HNN paper (docs: peers)
-  }
   std::string table_note() const override {
     return "Double pendulum: energy_error_end is the LNN paper's |E(T) - E(0)| / 29.4 at T = 100.";
   }

@@ -78,7 +78,6 @@ struct NBodySettings {
   // ints, not a vector: a second vector in this aggregate set off GCC 12's -Wmaybe-uninitialized.
   int lean_width, lean_depth;
   RolloutConfig rollout;
-  PaperRow baseline, hnn;
 };
 
 class NBodyTask : public FieldTask {
@@ -162,9 +161,6 @@ class NBodyTask : public FieldTask {
   Batch rollout_states(const Dataset&, int count, std::mt19937_64& rng) const override {
     return system_.sample_initial_states(count, rng);
   }
-  PaperRow paper(nn::ModelKind model) const override {
-    return model == nn::ModelKind::kHnn ? settings_.hnn : settings_.baseline;
-  }
 
  private:
   NBodySettings settings_;
@@ -182,9 +178,7 @@ std::unique_ptr<Task> make_two_body_task() {
       .train = {.steps = 10000, .batch_size = 200, .weight_decay = 0.0},
       .lean_width = 32,  // 18x faster to train, test loss and energy MSE within the noise
       .lean_depth = 2,
-      .rollout = {.t_end = 20.0, .points = 1000},
-      .baseline = {{3.2682e-5, 1.2e-6}, {2.9575e-5, 8.9e-7}, {6.3276e-2, 3.4e-2}},
-      .hnn = {{2.9959e-6, 6.6e-8}, {2.8218e-6, 4.2e-8}, {3.8751e-5, 5.0e-6}}});
+      .rollout = {.t_end = 20.0, .points = 1000}});
 }
 
 std::unique_ptr<Task> make_three_body_task() {
@@ -197,9 +191,7 @@ std::unique_ptr<Task> make_three_body_task() {
       // The paper's: every smaller model's energy MSE blew up on some seed of the sweep.
       .lean_width = 200,
       .lean_depth = 2,
-      .rollout = {.t_end = 20.0, .points = 100},
-      .baseline = {{9.5573e-2, 6.6e-2}, {3.8000e-1, 4.2e-1}, {1.0906e+2, 7.7e+1}},
-      .hnn = {{8.0346e-2, 2.1e-2}, {4.8809e-1, 4.8e-1}, {4.1926e-2, 3.4e-2}}});
+      .rollout = {.t_end = 20.0, .points = 100}});
 }
 
 }  // namespace hnn::tasks

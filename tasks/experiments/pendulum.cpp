@@ -21,11 +21,6 @@ class PendulumTask : public OscillatorTask {
   // The `lean` preset (docs/speed_accuracy.md, chart 4): within the noise of 200-200.
   std::vector<int> lean_hidden() const override { return {32, 32}; }
   const physics::System& truth() const override { return pendulum_; }
-  PaperRow paper(nn::ModelKind model) const override {
-    return model == nn::ModelKind::kHnn
-               ? PaperRow{{3.2787e-2, 1.8e-3}, {3.5586e-2, 1.8e-3}, {2.4852e-2, 5.4e-3}}
-               : PaperRow{{3.2606e-2, 1.7e-3}, {3.5273e-2, 1.8e-3}, {4.1519e-2, 9.6e-3}};
-  }
 
  private:
   physics::Pendulum pendulum_;

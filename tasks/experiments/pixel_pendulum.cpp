@@ -149,11 +149,6 @@ class PixelPendulumTask : public Task {
             .weight_decay = c.weight_decay,
             .hidden = c.hidden};
   }
-  PaperRow paper(nn::ModelKind model) const override {
-    return model == nn::ModelKind::kHnn
-               ? PaperRow{{1.8683e-4, 2.4e-6}, {1.8451e-4, 3.3e-6}, {1.5315e-4, 8.4e-6}}
-               : PaperRow{{1.7731e-4, 2.4e-6}, {1.7306e-4, 3.2e-6}, {9.2748e-3, 1.1e-3}};
-  }
   std::string table_note() const override {
     return "Pixel pendulum: losses are the combined ae + cc + 0.1 hnn per frame pair; energy MSE "
            "is between the true Gym state's energy and the energy of the angle and velocity "

@@ -44,9 +44,6 @@ class RealDoublePendulumTask : public FieldTask {
   TrainConfig train_config() const override {
     return {.steps = 5000, .batch_size = 256, .learning_rate = 1e-3, .hidden = {128, 128}};
   }
-  PaperRow paper(nn::ModelKind) const override {
-    return {{NAN, NAN}, {NAN, NAN}, {NAN, NAN}};  // no peer has trained on it
-  }
   std::string table_note() const override {
     return "Real double pendulum: no true system; the rollouts follow measured held-out "
            "trajectories for 1 s from test states (state_mse_t0.05 .. state_mse_t0.5, "

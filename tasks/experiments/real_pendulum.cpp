@@ -45,11 +45,6 @@ class RealPendulumTask : public FieldTask {
       states.row(i) = data.test_x.row(i * data.test_x.rows() / n);
     return states;
   }
-  PaperRow paper(nn::ModelKind model) const override {
-    return model == nn::ModelKind::kHnn
-               ? PaperRow{{9.2376e-3, 5.0e-4}, {5.9584e-3, 6.2e-4}, {1.4477e-2, 4.7e-3}}
-               : PaperRow{{2.7455e-3, 2.1e-4}, {2.1864e-3, 3.3e-4}, {3.8564e-1, 6.9e-2}};
-  }
   bool reads_data_file() const override { return true; }
   // Consecutive rows of one trial on one side of the split, at the file's times.
   std::optional<SplitStretches> stretches(const RunSettings& settings,

@@ -21,11 +21,6 @@ class SpringTask : public OscillatorTask {
   // The `lean` preset (docs/speed_accuracy.md, chart 4): within the noise of 200-200.
   std::vector<int> lean_hidden() const override { return {16, 16}; }
   const physics::System& truth() const override { return spring_; }
-  PaperRow paper(nn::ModelKind model) const override {
-    return model == nn::ModelKind::kHnn
-               ? PaperRow{{3.6933e-2, 1.9e-3}, {3.5928e-2, 1.8e-3}, {3.8416e-4, 6.5e-5}}
-               : PaperRow{{3.7134e-2, 1.9e-3}, {3.6656e-2, 1.9e-3}, {1.7077e-1, 2.1e-2}};
-  }
 
  private:
   physics::Spring spring_;

@@ -17,7 +17,7 @@ import unittest
 
 HNN = os.environ.get("HNN_EXE", "build/apps/hnn")
 SOURCE = os.environ.get("HNN_SOURCE_DIR", os.getcwd())
-PEERS = os.path.join(SOURCE, "apps", "hnn", "compare", "peers.json")
+PEERS = os.path.join(SOURCE, "data", "peers.json")
 
 
 def hnn(*args):
@@ -213,12 +213,13 @@ class Tiny(CompareCase):
                 # and in the markdown, as printed
                 line = f"| {key} | {mean:.3e} ± {se:.1e} |"
                 self.assertIn(line, md)
-            # the peers' numbers on this row: exactly the peers file's for its task and model
+            # the peers' numbers on this row: exactly the peers file's for its task and model (the
+            # HNN paper's Table 1 among them: every row runs at its task's defaults)
             want = {(p["metric"], p["value"]) for p in peers
                     if p["task"] == row["task"] and p.get("model") == row["model"]
                     and (p.get("loss") or "derivative") == row["loss"]}
             got = {(l["peer"].get("metric"), l["peer"]["value"]) for l in row["lines"]
-                   if l["peer"] and not l["peer"]["source"].startswith("the HNN paper")}
+                   if l["peer"]}
             self.assertEqual(got, want, row["task"] + " " + row["model"])
         # damped spring: the D-HNN paper's state MSE beside ours, on the same line
         dhnn_state = next(p for p in peers if p["task"] == "damped-spring"
@@ -226,7 +227,7 @@ class Tiny(CompareCase):
         self.assertRegex(md, r"\| damped-spring \| dhnn \| derivative \| dhnn_paper_state_mse \| "
                          + r"[0-9.e+-]+ ± "
                          + r"[0-9.e+-]+ \| 2/2 \| " + re.escape(f"{dhnn_state['value']:.3e}"))
-        # spring: the HNN paper's Table 1 (Task::paper) beside ours
+        # spring: the HNN paper's Table 1 (its entries in the peers file) beside ours
         self.assertIn("| 3.842e-04 ± 6.5e-05 | HNN (Greydanus et al. 2019): HNN", md)
 
         # The second invocation trains nothing and writes the same table.

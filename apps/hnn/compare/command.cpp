@@ -15,11 +15,11 @@
 
 #include "apps/hnn/commands/commands.h"
 #include "apps/hnn/commands/validators.h"
-#include "apps/hnn/compare/peers.h"
 #include "apps/hnn/sweep/keys.h"
 #include "apps/hnn/sweep/launch.h"
 #include "tasks/data/data_files.h"
 #include "tasks/experiments/registry.h"
+#include "tasks/studies/published.h"
 #include "tasks/task.h"
 
 namespace hnn::app {
@@ -233,14 +233,21 @@ json rows_json(const std::vector<Row>& rows) {
 }
 
 json compare_section(const std::vector<Row>& rows, const CompareOptions& o) {
-  const fs::path file = peers_path();
-  json peers_doc = read_peers(file);
-  std::vector<std::string> own_settings;  // tasks with rows at their own settings: Table 1's
+  const fs::path file = tasks::published_path();
+  const json peers_doc = tasks::read_published(file);
+  std::vector<std::string> own_settings;  // tasks with rows at their own settings
   for (const Row& row : rows) {
     if (row.keys.empty() && !contains(own_settings, row.task)) own_settings.push_back(row.task);
   }
-  json peers = table1_peers(own_settings);
-  for (const json& p : peers_doc["peers"]) peers.push_back(p);
+  // A number that holds only at a task's defaults (the HNN paper's Table 1) is a peer only of a
+  // task the study runs at its defaults, in the study's order of tasks; the others follow.
+  const auto defaults_only = [](const json& p) { return p.value("task_defaults_only", false); };
+  json peers = json::array();
+  for (const std::string& task : own_settings)
+    for (const json& p : peers_doc["peers"])
+      if (defaults_only(p) && p["task"] == task) peers.push_back(p);
+  for (const json& p : peers_doc["peers"])
+    if (!defaults_only(p)) peers.push_back(p);
   return {{"command", o.command},
           {"seeds", o.seeds},
           {"steps", o.steps > 0 ? json(o.steps) : json("each task's default")},

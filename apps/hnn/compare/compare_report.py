@@ -206,7 +206,7 @@ def markdown(doc):
           + "), one line per metric of "
           "metrics.json. Peers: their published number on the same metric and protocol, from "
           f"`{os.path.basename(doc['peers_file'])}` (its entries name their sources; the HNN "
-          "paper's Table 1 comes from each task, as in `hnn reproduce`). A peer number whose "
+          "paper's Table 1 among them, as `hnn reproduce` reads it). A peer number whose "
           f"protocol hnn does not measure yet says \"{NOT_MEASURED}\" rather than sit beside "
           "another quantity. Footnotes give each peer's protocol.\n",
           "| task | model | loss | metric | ours | seeds | peer's number | peer |",
