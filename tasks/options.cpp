@@ -6,9 +6,11 @@
 #include <charconv>
 #include <cmath>
 #include <sstream>
+#include <stdexcept>
 
 #include "tasks/error.h"
 #include "tasks/report/json_values.h"
+#include "tasks/train_options.h"
 
 namespace hnn::tasks {
 
@@ -75,41 +77,88 @@ std::string join_widths(const std::vector<int>& widths) {
   return s;
 }
 
+namespace {
+
+// An option's setting in `s`, as RunSettings::to_json records it under the option's key.
+json recorded_value(const TrainOption& option, const RunSettings& s) {
+  switch (option.lands) {
+    case Lands::kTask:
+      return s.task;
+    case Lands::kModel:
+      return nn::to_string(s.model);
+    case Lands::kSeed:
+      return s.seed;
+    case Lands::kDtype:
+      return tasks::to_string(s.dtype);
+    case Lands::kPreset:
+      return tasks::to_string(s.preset);
+    case Lands::kThreads:
+      return s.threads;
+    case Lands::kSteps:
+      return s.train.steps;
+    case Lands::kBatchSize:
+      return s.train.batch_size;
+    case Lands::kHidden:
+      return join_widths(s.train.hidden);
+    case Lands::kLearningRate:
+      return s.train.learning_rate;
+    case Lands::kLrSchedule:
+      return to_string(s.train.lr_schedule);
+    case Lands::kDataFile:
+      return s.data_file;
+    case Lands::kTaskSettings:
+      return s.task_settings;
+    default:
+      throw std::logic_error(fmt::format("--{} is not recorded in a run's settings", option.name));
+  }
+}
+
+// A recorded value as apply() takes it; throws naming the key.
+json from_record(const TrainOption& option, const json& j) {
+  const std::string key(option.key);
+  switch (option.kind) {
+    case ValueKind::kSeed:
+      return json_integer<std::uint64_t>(j, key);
+    case ValueKind::kInt:
+      return json_integer<int>(j, key);
+    case ValueKind::kHidden:
+      return widths_from_json(j);
+    case ValueKind::kPositiveReal:
+      return j.get<double>();
+    case ValueKind::kJsonObject:
+      return j;
+    default:
+      return j.get<std::string>();
+  }
+}
+
+// The options RunSettings::to_json records: those with a key outside the task's settings.
+bool recorded(const TrainOption& option) {
+  return !option.key.empty() && option.lands != Lands::kTaskSetting;
+}
+
+}  // namespace
+
 json RunSettings::to_json() const {
-  return {{"task", task},
-          {"model", nn::to_string(model)},
-          {"seed", seed},
-          {"dtype", tasks::to_string(dtype)},
-          {"preset", tasks::to_string(preset)},
-          {"threads", threads},
-          {"steps", train.steps},
-          {"batch_size", train.batch_size},
-          {"hidden", join_widths(train.hidden)},
-          {"learning_rate", train.learning_rate},
-          {"weight_decay", train.weight_decay},
-          {"lr_schedule", to_string(train.lr_schedule)},
-          {"data_file", data_file},
-          {"task_settings", task_settings}};
+  json j;
+  for (const TrainOption& option : train_options())
+    if (recorded(option)) j[std::string(option.key)] = recorded_value(option, *this);
+  j["weight_decay"] = train.weight_decay;  // no option sets it: each task's TrainConfig does
+  return j;
 }
 
 RunOptions options_from_json(const json& j, const std::string& where) {
   RunOptions o;
   try {
-    o.task = j.at("task");
-    o.model = parse_model(j.at("model").get<std::string>());
-    o.seed = json_integer<std::uint64_t>(j.at("seed"), "seed");
-    o.dtype = parse_dtype(j.at("dtype").get<std::string>());
-    o.preset = parse_preset(j.value("preset", "paper"));  // runs before the presets have none
-    o.threads = json_integer<int>(j.value("threads", json(2)), "threads");
-    o.steps = json_integer<int>(j.at("steps"), "steps");
-    o.batch_size = json_integer<int>(j.at("batch_size"), "batch_size");
-    o.hidden = widths_from_json(j.at("hidden"));
-    o.learning_rate = j.at("learning_rate").get<double>();
+    for (const TrainOption& option : train_options()) {
+      if (!recorded(option)) continue;
+      const std::string key(option.key);
+      const json value = j.contains(key) || option.recorded_default.empty()
+                             ? j.at(key)
+                             : json::parse(option.recorded_default);
+      apply(option, from_record(option, value), o);
+    }
     if (j.contains("weight_decay")) o.weight_decay = j["weight_decay"].get<double>();
-    // Runs from before the schedules trained at a constant rate.
-    o.lr_schedule = parse_lr_schedule(j.value("lr_schedule", "constant"));
-    o.data_file = j.value("data_file", "");
-    o.task_settings = j.value("task_settings", json::object());
   } catch (const std::exception& e) {
     throw Error(fmt::format("{} does not hold a run's settings: {}", where, e.what()));
   }

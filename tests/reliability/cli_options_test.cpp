@@ -3,7 +3,13 @@
 
 #include <gtest/gtest.h>
 
+#include <map>
+#include <set>
+
 #include "reliability_util.h"
+#include "tasks/experiments/registry.h"
+#include "tasks/run.h"
+#include "tasks/train_options.h"
 
 namespace hnn::reliability {
 namespace {
@@ -187,6 +193,147 @@ TEST(CliOptions, HelpStillExitsZero) {
   EXPECT_EQ(r.code, 0);
   EXPECT_NE(r.out.find("--resume"), std::string::npos);
   EXPECT_NE(r.out.find("--checkpoint-every"), std::string::npos);
+}
+
+// ---- the table of `hnn train`'s options (tasks/train_options.h) makes each of its forms -------
+
+using nlohmann::json;
+using tasks::TrainOption;
+
+// "--model"; "task" for the positional TASK.
+std::string cli_name(const TrainOption& option) {
+  const std::string name(option.name);
+  return option.kind == tasks::ValueKind::kTask ? name : "--" + name;
+}
+
+TEST(TrainOptionsTable, EveryRowIsAnOptionOfHnnTrainUnderItsHeadingWithItsDefault) {
+  const TempDir dir;
+  const Result r = run_hnn({"train", "--help"}, dir.path());
+  ASSERT_EQ(r.code, 0);
+  // Each option's line (two spaces in; deeper lines carry on a help text) under its heading.
+  std::map<std::string, std::pair<std::string, std::string>> listed;  // name -> heading, line
+  std::string heading;
+  for (const std::string& line : lines(r.out)) {
+    if (!line.empty() && line[0] != ' ') heading = line.substr(0, line.find_last_of(':'));
+    if (line.size() < 3 || !line.starts_with("  ") || line[2] == ' ') continue;
+    listed[line.substr(2, line.find(' ', 2) - 2)] = {heading, line};
+  }
+  listed.erase("-h,--help");
+  EXPECT_EQ(listed.size(), tasks::train_options().size()) << r.out;
+  for (const TrainOption& option : tasks::train_options()) {
+    const std::string name = cli_name(option);
+    ASSERT_TRUE(listed.count(name)) << name << " is not in hnn train --help:\n" << r.out;
+    const auto& [under, line] = listed.at(name);
+    const std::string group(option.group);
+    EXPECT_EQ(under, option.kind == tasks::ValueKind::kTask ? "Positionals"
+                     : group.empty()                        ? "Options"
+                                                            : group)
+        << name;
+    if (!option.default_shown.empty())
+      EXPECT_NE(line.find("=" + std::string(option.default_shown)), std::string::npos) << line;
+  }
+}
+
+TEST(TrainOptionsTable, TheDefaultsShownAreRunOptionsOwn) {
+  const std::unique_ptr<tasks::Task> task = tasks::make_task("spring");
+  const json defaults = tasks::resolve(*task, {.task = "spring"}).to_json();
+  for (const TrainOption& option : tasks::train_options()) {
+    if (option.default_shown.empty()) continue;
+    const std::string text(option.default_shown);
+    tasks::RunOptions o{.task = "spring"};
+    tasks::apply(option, option.kind == tasks::ValueKind::kChoice ? json(text) : json::parse(text),
+                 o);
+    EXPECT_EQ(tasks::resolve(*task, o).to_json(), defaults) << option.name;
+  }
+}
+
+TEST(TrainOptionsTable, TheSweepKeysAreItsRowsInRankOrderAndTheOthersAreRefusedWithTheReason) {
+  const TempDir dir;
+  // A value of every sweep key: a data run that trains through an integrator.
+  const json values = json::parse(R"({
+      "task": "data", "model": "baseline", "seed": 3, "dtype": "float", "preset": "lean",
+      "hidden": [8], "steps": 5, "batch": 0, "lr": 0.01, "lr-schedule": "cosine",
+      "data": "x.csv", "settings": {"threshold": 0.2}, "checkpoint-every": 2, "coords": "q",
+      "momenta": "p", "velocities": "v", "derivatives": "dq,dp", "time": "t",
+      "trajectory": "traj", "split": "time", "test-fraction": 0.3, "hamiltonian": "q^2",
+      "loss": "rollout", "horizon": 2, "integrator": "leapfrog", "dt": 0.05})");
+  json spec = json::object();
+  std::vector<const TrainOption*> keys;
+  for (const TrainOption& option : tasks::train_options()) {
+    const std::string name(option.name);
+    if (!option.sweep_owned.empty()) {
+      write_text(dir / "owned.json", json({{"task", {"spring"}}, {name, {1}}}).dump());
+      const Result r = run_hnn(
+          {"sweep", (dir / "owned.json").string(), "--out", (dir / "owned").string(), "--list"},
+          dir.path());
+      EXPECT_EQ(r.code, 1) << name;
+      EXPECT_NE(r.err.find("key '" + name + "': " + std::string(option.sweep_owned)),
+                std::string::npos)
+          << r.err;
+      continue;
+    }
+    ASSERT_TRUE(values.contains(name)) << "give the sweep key " << name << " a value here";
+    spec[name] = {values.at(name)};
+    keys.push_back(&option);
+  }
+  EXPECT_EQ(keys.size(), values.size());
+  write_text(dir / "all.json", spec.dump());
+  const Result r =
+      run_hnn({"sweep", (dir / "all.json").string(), "--out", (dir / "all").string(), "--list"},
+              dir.path());
+  ASSERT_EQ(r.code, 0) << r.err;
+  std::sort(keys.begin(), keys.end(), [](const TrainOption* a, const TrainOption* b) {
+    return a->sweep_rank < b->sweep_rank;
+  });
+  std::size_t at = r.out.find("hnn train data ");
+  ASSERT_NE(at, std::string::npos) << r.out;
+  for (const TrainOption* key : keys) {
+    if (key->kind == tasks::ValueKind::kTask) continue;
+    const std::size_t next = r.out.find(" --" + std::string(key->name) + " ", at);
+    EXPECT_NE(next, std::string::npos) << key->name << " missing or out of order: " << r.out;
+    at = next == std::string::npos ? at : next;
+  }
+  std::set<int> ranks;
+  for (const TrainOption* key : keys) ranks.insert(key->sweep_rank);
+  EXPECT_EQ(ranks.size(), keys.size());
+  EXPECT_EQ(*ranks.begin(), 0);
+  EXPECT_EQ(*ranks.rbegin(), int(keys.size()) - 1);
+}
+
+TEST(TrainOptionsTable, TheJsonFormReadsBackAsItWasWrittenAndOldRunsGetTheRecordedDefaults) {
+  const std::unique_ptr<tasks::Task> task = tasks::make_task("spring");
+  const tasks::RunOptions o{.task = "spring",
+                            .model = nn::ModelKind::kBaseline,
+                            .seed = 9,
+                            .dtype = tasks::Dtype::kFloat,
+                            .preset = tasks::Preset::kLean,
+                            .threads = 3,
+                            .steps = 7,
+                            .batch_size = 5,
+                            .hidden = std::vector<int>{8, 4},
+                            .learning_rate = 0.02,
+                            .weight_decay = 1e-4,
+                            .lr_schedule = tasks::LrSchedule::kCosine,
+                            .task_settings = {{"loss", "rollout"}, {"horizon", 2}}};
+  const json j = tasks::resolve(*task, o).to_json();
+  // Its keys: the table's recorded options, and the weight decay (each task's, no option's).
+  std::set<std::string> recorded = {"weight_decay"};
+  for (const TrainOption& option : tasks::train_options())
+    if (!option.key.empty() && option.lands != tasks::Lands::kTaskSetting)
+      recorded.insert(std::string(option.key));
+  std::set<std::string> written;
+  for (const auto& [key, value] : j.items()) written.insert(key);
+  EXPECT_EQ(written, recorded);
+  EXPECT_EQ(tasks::resolve(*task, tasks::options_from_json(j, "test")).to_json(), j);
+  // A run from before a key existed reads that key's recorded default.
+  json old = j;
+  for (const TrainOption& option : tasks::train_options())
+    if (!option.recorded_default.empty()) old.erase(std::string(option.key));
+  const json back = tasks::resolve(*task, tasks::options_from_json(old, "old")).to_json();
+  for (const TrainOption& option : tasks::train_options()) {
+    if (option.recorded_default.empty()) continue;
+    EXPECT_EQ(back[std::string(option.key)], json::parse(option.recorded_default)) << option.name;
+  }
 }
 
 }  // namespace

@@ -2,18 +2,10 @@
 // The subcommands of the hnn program; each registers its options on the CLI11 app.
 
 #include <CLI/CLI.hpp>
-#include <functional>
-#include <nlohmann/json.hpp>
-#include <string>
 
 namespace hnn::app {
 
 void add_train_command(CLI::App& app);
-/// The data task's options of `hnn train` (apps/hnn/commands/data_options.cpp). The returned
-/// function, called after parsing, writes those given into the task's settings, and refuses them
-/// when the task is not `data`.
-std::function<void(nlohmann::json& settings, const std::string& task)> add_data_options(
-    CLI::App& train);
 void add_evaluate_command(CLI::App& app);
 void add_rollout_command(CLI::App& app);
 void add_reproduce_command(CLI::App& app);

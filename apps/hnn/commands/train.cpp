@@ -4,14 +4,18 @@
 #include <fmt/format.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <csignal>
+#include <cstdint>
 #include <cstdio>
-#include <limits>
+#include <span>
+#include <vector>
 
 #include "apps/hnn/commands/commands.h"
 #include "apps/hnn/commands/validators.h"
 #include "tasks/experiments/registry.h"
 #include "tasks/run.h"
+#include "tasks/train_options.h"
 
 namespace hnn::app {
 
@@ -60,31 +64,17 @@ void train_until_done_or_stopped(tasks::RunOptions o) {
   }
 }
 
-// `hnn train --resume DIR`: the settings are the checkpoint's; only options that cannot change
-// the result may be given again.
-tasks::RunOptions resumed_options(const CLI::App& cmd, const std::string& dir, bool quiet) {
-  for (const char* name : {"task",          "--model",       "--steps",
-                           "--seed",        "--dtype",       "--preset",
-                           "--batch",       "--hidden",      "--lr",
-                           "--lr-schedule", "--data",        "--settings",
-                           "--out",         "--coords",      "--momenta",
-                           "--velocities",  "--derivatives", "--time",
-                           "--trajectory",  "--split",       "--test-fraction",
-                           "--hamiltonian", "--loss",        "--horizon",
-                           "--integrator",  "--dt"}) {
-    if (cmd.get_option(name)->count() > 0) {
-      throw std::invalid_argument(fmt::format(
-          "{} cannot be combined with --resume: a resumed run keeps its own settings", name));
-    }
-  }
-  tasks::RunOptions o = tasks::resume_options(dir);
-  o.quiet = quiet;
-  if (cmd.get_option("--threads")->count() > 0) o.threads = cmd.get_option("--threads")->as<int>();
-  if (cmd.get_option("--checkpoint-every")->count() > 0) {
-    o.checkpoint_every = cmd.get_option("--checkpoint-every")->as<long>();
-  }
-  return o;
-}
+// One option's value as CLI11 reads it: the member its kind binds, so numbers are parsed by
+// CLI11 as they always were.
+struct Given {
+  std::string text;
+  std::vector<std::string> texts;
+  std::vector<long long> integers;
+  long long integer = 0;
+  std::uint64_t seed = 0;
+  double real = 0;
+  bool flag = false;
+};
 
 // --settings: a JSON object, or one line saying why not.
 nlohmann::json task_settings(const std::string& text) {
@@ -96,83 +86,124 @@ nlohmann::json task_settings(const std::string& text) {
   return j;
 }
 
+// `option` on the command line, bound to `given` and checked by its kind.
+CLI::Option* add_option(CLI::App& cmd, const tasks::TrainOption& option, Given& given) {
+  using tasks::ValueKind;
+  if (option.kind == ValueKind::kTask) {
+    return cmd.add_option(std::string(option.name), given.text,
+                          fmt::format(fmt::runtime(option.help), task_list()));
+  }
+  const std::string name = "--" + std::string(option.name), help(option.help);
+  switch (option.kind) {
+    case ValueKind::kFlag:
+      return cmd.add_flag(name, given.flag, help);
+    case ValueKind::kChoice:
+      return cmd.add_option(name, given.text, help)->check(CLI::IsMember(option.choices()));
+    case ValueKind::kSeed:
+      return cmd.add_option(name, given.seed, help)->check(seed_value());
+    case ValueKind::kInt: {
+      CLI::Option* o = cmd.add_option(name, given.integer, help);
+      if (option.range_in_help) return o->check(CLI::Range(option.min, option.max));
+      return o->check(integer_in(option.min, option.max));
+    }
+    case ValueKind::kHidden:
+      return cmd.add_option(name, given.integers, help)->check(integer_in(1, tasks::kMaxWidth));
+    case ValueKind::kPositiveReal:
+      return cmd.add_option(name, given.real, help)->check(positive_real());
+    case ValueKind::kFraction:
+      return cmd.add_option(name, given.real, help)
+          ->check(CLI::Range(0.0, 1.0).description("in (0, 1)"));
+    case ValueKind::kColumns:
+      return cmd.add_option(name, given.texts, help)->delimiter(',');
+    case ValueKind::kRunFolder:
+      return cmd.add_option(name, given.text, help)->check(CLI::ExistingDirectory);
+    default:  // a file, a folder, a JSON object's text, a column's name
+      return cmd.add_option(name, given.text, help);
+  }
+}
+
+// The value given, as tasks::apply takes it; null for an empty --settings (as if not given).
+nlohmann::json given_value(const tasks::TrainOption& option, const Given& given) {
+  using tasks::ValueKind;
+  switch (option.kind) {
+    case ValueKind::kFlag:
+      return given.flag;
+    case ValueKind::kSeed:
+      return given.seed;
+    case ValueKind::kInt:
+      return given.integer;
+    case ValueKind::kHidden:
+      return given.integers;
+    case ValueKind::kPositiveReal:
+    case ValueKind::kFraction:
+      return given.real;
+    case ValueKind::kColumns:
+      return given.texts;
+    case ValueKind::kJsonObject:
+      return given.text.empty() ? nlohmann::json() : task_settings(given.text);
+    default:
+      return given.text;
+  }
+}
+
+// "--model"; "task" for the positional TASK.
+std::string cli_name(const tasks::TrainOption& option) {
+  const std::string name(option.name);
+  return option.kind == tasks::ValueKind::kTask ? name : "--" + name;
+}
+
+// The options of a run from those given. With --resume, the run's own from its checkpoint, and
+// on top only the options that cannot change the result (the table's with_resume).
+tasks::RunOptions run_options(const CLI::App& cmd, const std::vector<Given>& given) {
+  const std::span<const tasks::TrainOption> table = tasks::train_options();
+  std::vector<std::size_t> asked;  // the options given, in the table's order
+  for (std::size_t i = 0; i < table.size(); ++i)
+    if (cmd.get_option(cli_name(table[i]))->count() > 0) asked.push_back(i);
+  const auto is = [&](tasks::Lands lands) {
+    return [&table, lands](std::size_t i) { return table[i].lands == lands; };
+  };
+  tasks::RunOptions o;
+  if (const auto resume = std::find_if(asked.begin(), asked.end(), is(tasks::Lands::kResume));
+      resume != asked.end()) {
+    for (std::size_t i : asked) {
+      if (!table[i].with_resume) {
+        throw std::invalid_argument(
+            fmt::format("{} cannot be combined with --resume: a resumed run keeps its own settings",
+                        cli_name(table[i])));
+      }
+    }
+    o = tasks::resume_options(given[*resume].text);
+  } else if (const auto task = std::find_if(asked.begin(), asked.end(), is(tasks::Lands::kTask));
+             task == asked.end() || given[*task].text.empty()) {
+    throw std::invalid_argument("train needs a TASK (or --resume DIR)");
+  }
+  for (std::size_t i : asked) {
+    const nlohmann::json value = given_value(table[i], given[i]);
+    if (value.is_null()) continue;
+    if (const std::string why = tasks::not_applicable(table[i], o.task); !why.empty())
+      throw std::invalid_argument(fmt::format("{} {}", cli_name(table[i]), why));
+    tasks::apply(table[i], value, o);  // the task first: it leads the table
+  }
+  return o;
+}
+
 }  // namespace
 
 void add_train_command(CLI::App& app) {
   auto* cmd = app.add_subcommand("train", "Train and evaluate one model on a task");
-  auto options = std::make_shared<tasks::RunOptions>();
-  auto model = std::make_shared<std::string>("hnn"),
-       dtype = std::make_shared<std::string>("double");
-  auto preset = std::make_shared<std::string>("paper");
-  auto steps = std::make_shared<int>(0), batch = std::make_shared<int>(-1);
-  auto lr = std::make_shared<double>(0);
-  auto hidden = std::make_shared<std::vector<int>>();
-  auto resume = std::make_shared<std::string>();
-  auto checkpoint_every = std::make_shared<long>(0);
-  cmd->add_option("task", options->task, "Task: " + task_list() + " (required unless --resume)");
-  cmd->add_option("--model", *model,
-                  "hnn, baseline, dhnn (the dissipative HNN: H and a dissipation potential D) or "
-                  "lnn (the Lagrangian NN: L(q, dq/dt))")
-      ->check(CLI::IsMember(tasks::model_names()))
-      ->capture_default_str();
-  cmd->add_option("--steps", *steps, "Training steps (default: the paper's)")
-      ->check(positive_integer());
-  cmd->add_option("--seed", options->seed, "Seed of the data, initialisation and batches")
-      ->check(seed_value())
-      ->capture_default_str();
-  cmd->add_option("--dtype", *dtype, "float or double")
-      ->check(CLI::IsMember(tasks::dtype_names()))
-      ->capture_default_str();
-  cmd->add_option("--threads", options->threads, "Threads for matrix products")
-      ->check(integer_in(1, 256))
-      ->capture_default_str();
-  cmd->add_option("--preset", *preset,
-                  "Model widths: paper (the paper's 200-200) or lean (the smallest within the "
-                  "noise of paper's accuracy); --hidden overrides either")
-      ->check(CLI::IsMember(tasks::preset_names()))
-      ->capture_default_str();
-  cmd->add_option("--batch", *batch, "Minibatch size (0: full batch; default: the paper's)")
-      ->check(integer_in(0, std::numeric_limits<int>::max()));
-  cmd->add_option("--hidden", *hidden, "Hidden widths, e.g. --hidden 200 200")
-      ->check(integer_in(1, tasks::kMaxWidth));
-  cmd->add_option("--lr", *lr, "Adam learning rate (default 1e-3)")->check(positive_real());
-  auto lr_schedule = std::make_shared<std::string>();
-  cmd->add_option("--lr-schedule", *lr_schedule,
-                  "constant (the default) or cosine: decay from --lr towards 0 at the last step")
-      ->check(CLI::IsMember({"constant", "cosine"}));
-  cmd->add_option("--data", options->data_file,
-                  "The data task's file, or real-pendulum's measured data in its format");
-  cmd->add_option("--out", options->out, "Run folder (default runs/TASK/MODEL)");
-  cmd->add_flag("--quiet", options->quiet, "No progress output");
-  auto settings = std::make_shared<std::string>();
-  cmd->add_option("--settings", *settings,
-                  "The task's own settings as a JSON object, e.g. pixel-pendulum's "
-                  "'{\"trials\": 20, \"ae_hidden\": 64}' (see its metrics.json's \"pixel\")");
-  cmd->add_option("--checkpoint-every", *checkpoint_every,
-                  "Steps between checkpoints in OUT/checkpoint (default: a tenth of the steps)")
-      ->check(positive_integer());
-  cmd->add_option("--resume", *resume,
-                  "Continue the interrupted run in this folder from its last checkpoint")
-      ->check(CLI::ExistingDirectory);
-  const auto data_options = add_data_options(*cmd);
-  cmd->callback([=] {
-    if (!resume->empty())
-      return train_until_done_or_stopped(resumed_options(*cmd, *resume, options->quiet));
-    tasks::RunOptions o = *options;
-    if (o.task.empty()) throw std::invalid_argument("train needs a TASK (or --resume DIR)");
-    o.model = tasks::parse_model(*model);
-    o.dtype = tasks::parse_dtype(*dtype);
-    o.preset = tasks::parse_preset(*preset);
-    if (!settings->empty()) o.task_settings = task_settings(*settings);
-    data_options(o.task_settings, o.task);
-    if (*steps > 0) o.steps = *steps;
-    if (*batch >= 0) o.batch_size = *batch;
-    if (*lr > 0) o.learning_rate = *lr;
-    if (!lr_schedule->empty()) o.lr_schedule = tasks::parse_lr_schedule(*lr_schedule);
-    if (!hidden->empty()) o.hidden = *hidden;
-    if (*checkpoint_every > 0) o.checkpoint_every = *checkpoint_every;
-    if (o.out.empty()) o.out = std::filesystem::path("runs") / o.task / *model;
-    tasks::check_no_unfinished_run(o.out);
+  const std::span<const tasks::TrainOption> table = tasks::train_options();
+  auto given = std::make_shared<std::vector<Given>>(table.size());
+  for (std::size_t i = 0; i < table.size(); ++i) {
+    CLI::Option* option = add_option(*cmd, table[i], (*given)[i]);
+    if (!table[i].group.empty()) option->group(std::string(table[i].group));
+    if (!table[i].default_shown.empty()) option->default_str(std::string(table[i].default_shown));
+  }
+  cmd->callback([cmd, given] {
+    tasks::RunOptions o = run_options(*cmd, *given);
+    if (!o.resume) {
+      if (o.out.empty()) o.out = std::filesystem::path("runs") / o.task / nn::to_string(o.model);
+      tasks::check_no_unfinished_run(o.out);
+    }
     train_until_done_or_stopped(o);
   });
 }

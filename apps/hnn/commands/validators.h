@@ -8,13 +8,8 @@
 #include <cstdint>
 #include <limits>
 #include <string>
-#include <vector>
 
 namespace hnn::app {
-
-/// The training losses `hnn train --loss` accepts (the data task's, for now): dx/dt targets, or
-/// the model's field integrated over windows of states.
-inline std::vector<std::string> loss_names() { return {"derivative", "rollout"}; }
 
 namespace detail {
 // The whole of `text` as a number of type N, or false.

@@ -197,8 +197,8 @@ sweep::SweepPlan expand_rows(std::vector<Row>& rows, const CompareOptions& o, co
     }
     keys.insert(one.keys.begin(), one.keys.end());
   }
-  for (const sweep::KeyInfo& k : sweep::key_table())
-    if (keys.count(std::string(k.name))) plan.keys.emplace_back(k.name);
+  for (const tasks::TrainOption* k : sweep::key_table())
+    if (keys.count(std::string(k->name))) plan.keys.emplace_back(k->name);
   return plan;
 }
 
@@ -272,7 +272,7 @@ void list_rows(const std::vector<Row>& rows) {
 void run_compare(CompareOptions o) {
   check_names(o.tasks, tasks::task_names(), "--tasks", "task");
   check_names(o.models, tasks::model_names(), "--models", "model");
-  check_names(o.losses, loss_names(), "--loss", "loss");
+  check_names(o.losses, tasks::loss_names(), "--loss", "loss");
   sweep::check_scheduler(o.launch.scheduler);
   if (o.quick && o.steps == 0) o.steps = kQuickSteps;
   const fs::path out = fs::absolute(o.out).lexically_normal();

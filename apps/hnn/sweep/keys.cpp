@@ -1,5 +1,5 @@
-// The spec's keys, `hnn train`'s options: each value checked, written as `hnn train`
-// arguments and in run folder names, and applied to tasks::RunOptions.
+// The spec's keys, `hnn train`'s options as its table declares them (tasks/train_options.h): each
+// value checked as JSON by its kind, written as `hnn train` arguments and in run folder names.
 
 #include "apps/hnn/sweep/keys.h"
 
@@ -9,57 +9,20 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <map>
 #include <sstream>
 #include <stdexcept>
 
-#include "apps/hnn/commands/validators.h"
 #include "tasks/experiments/registry.h"
-#include "tasks/task.h"
 
 namespace hnn::app::sweep {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
 using nlohmann::ordered_json;
+using tasks::TrainOption;
+using tasks::ValueKind;
 
 namespace {
-
-// `hnn train`'s options, in the canonical order of run names and table columns.
-constexpr KeyInfo kKeys[] = {
-    {"task", Kind::kTask},
-    {"model", Kind::kModel},
-    {"seed", Kind::kSeed},
-    {"dtype", Kind::kDtype},
-    {"preset", Kind::kPreset},
-    {"hidden", Kind::kHidden},
-    {"steps", Kind::kPositiveInt},
-    {"batch", Kind::kNonNegativeInt},
-    {"lr", Kind::kPositiveReal},
-    {"lr-schedule", Kind::kLrSchedule},
-    {"data", Kind::kFile},
-    {"settings", Kind::kObject},
-    {"checkpoint-every", Kind::kPositiveInt},
-    {"coords", Kind::kColumns, "coords"},
-    {"momenta", Kind::kColumns, "momenta"},
-    {"velocities", Kind::kColumns, "velocities"},
-    {"derivatives", Kind::kColumns, "derivatives"},
-    {"time", Kind::kText, "time"},
-    {"trajectory", Kind::kText, "trajectory"},
-    {"split", Kind::kSplit, "split"},
-    {"test-fraction", Kind::kFraction, "test_fraction"},
-    {"hamiltonian", Kind::kText, "hamiltonian"},
-    {"loss", Kind::kLoss, "loss"},
-    {"horizon", Kind::kPositiveInt, "horizon"},
-    {"integrator", Kind::kText, "integrator"},
-};
-
-// Options of `hnn train` that the sweep sets itself.
-const std::map<std::string_view, std::string_view> kSweepOwned = {
-    {"threads", "set by hnn sweep for every run (--threads-per-run)"},
-    {"out", "set by hnn sweep (OUT/runs/<run>)"},
-    {"resume", "hnn sweep resumes interrupted runs by itself"},
-    {"quiet", "hnn sweep runs quietly"}};
 
 std::invalid_argument bad(std::string message) { return std::invalid_argument(message); }
 
@@ -128,31 +91,19 @@ std::string folder_safe(const std::string& text) {
 
 // The value in its canonical form (hidden as a list, a file as an absolute path, ...), or
 // std::invalid_argument saying what was expected.
-ordered_json checked_value(const KeyInfo& key, const ordered_json& v) {
+ordered_json checked_value(const TrainOption& key, const ordered_json& v) {
   switch (key.kind) {
-    case Kind::kTask:
+    case ValueKind::kTask:
       return one_of(v, tasks::task_names(), "task");
-    case Kind::kModel:
-      return one_of(v, tasks::model_names(), "model");
-    case Kind::kDtype:
-      return one_of(v, tasks::dtype_names(), "dtype");
-    case Kind::kPreset:
-      return one_of(v, tasks::preset_names(), "preset");
-    case Kind::kSplit:
-      return one_of(v, {"auto", "trajectories", "time"}, "split");
-    case Kind::kLrSchedule:
-      return one_of(v, {"constant", "cosine"}, "learning-rate schedule");
-    case Kind::kLoss:
-      return one_of(v, loss_names(), "loss");
-    case Kind::kSeed:
+    case ValueKind::kChoice:
+      return one_of(v, key.choices(), key.noun);
+    case ValueKind::kSeed:
       if (v.is_number_unsigned()) return v;
       throw bad(
           fmt::format("expected an integer from 0 to 18446744073709551615, got {}", v.dump()));
-    case Kind::kPositiveInt:
-      return integer_in(v, 1, std::numeric_limits<int>::max());
-    case Kind::kNonNegativeInt:
-      return integer_in(v, 0, std::numeric_limits<int>::max());
-    case Kind::kHidden: {
+    case ValueKind::kInt:
+      return integer_in(v, key.min, key.max);
+    case ValueKind::kHidden: {
       ordered_json widths = ordered_json::array();
       for (const ordered_json& w : v.is_array() ? v : ordered_json::array({v})) {
         try {
@@ -165,115 +116,93 @@ ordered_json checked_value(const KeyInfo& key, const ordered_json& v) {
       if (widths.empty()) throw bad("expected at least one hidden width, got []");
       return widths;
     }
-    case Kind::kPositiveReal:
+    case ValueKind::kPositiveReal:
       if (v.is_number() && std::isfinite(v.get<double>()) && v.get<double>() > 0) return v;
       throw bad(fmt::format("expected a finite number > 0, got {}", v.dump()));
-    case Kind::kFraction:
+    case ValueKind::kFraction:
       if (v.is_number() && v.get<double>() > 0 && v.get<double>() < 1) return v;
       throw bad(fmt::format("expected a number in (0, 1), got {}", v.dump()));
-    case Kind::kFile:
+    case ValueKind::kFile:
       if (v.is_string() && !v.get<std::string>().empty())
         return fs::absolute(v.get<std::string>()).lexically_normal().string();
       throw bad(fmt::format("expected a file name, got {}", v.dump()));
-    case Kind::kObject:
+    case ValueKind::kJsonObject:
       if (v.is_object()) return v;
       throw bad(
           fmt::format("expected the task's settings as an object, like {{\"trials\": 20}}, "
                       "got {}",
                       v.dump()));
-    case Kind::kColumns:
+    case ValueKind::kColumns:
       return columns(v);
-    case Kind::kText:
+    case ValueKind::kText:
       if (v.is_string() && !v.get<std::string>().empty()) return v;
       throw bad(fmt::format("expected a non-empty string, got {}", v.dump()));
+    case ValueKind::kFolder:
+    case ValueKind::kRunFolder:
+    case ValueKind::kFlag:
+      break;  // out, resume and quiet: the sweep's own (sweep_owned)
   }
-  throw bad("unhandled key");
+  throw bad(fmt::format("--{} is not a sweep key", key.name));
 }
 
-std::span<const KeyInfo> key_table() { return kKeys; }
+const std::vector<const TrainOption*>& key_table() {
+  static const std::vector<const TrainOption*> keys = [] {
+    std::vector<const TrainOption*> k;
+    for (const TrainOption& option : tasks::train_options())
+      if (option.sweep_owned.empty()) k.push_back(&option);
+    std::sort(k.begin(), k.end(), [](const TrainOption* a, const TrainOption* b) {
+      return a->sweep_rank < b->sweep_rank;
+    });
+    return k;
+  }();
+  return keys;
+}
 
-const KeyInfo* find_key(std::string_view name) {
-  for (const KeyInfo& k : kKeys)
-    if (k.name == name) return &k;
-  return nullptr;
+const TrainOption* find_key(std::string_view name) {
+  const TrainOption* option = tasks::find_train_option(name);
+  return option != nullptr && option->sweep_owned.empty() ? option : nullptr;
 }
 
 std::string_view sweep_owned(std::string_view name) {
-  const auto it = kSweepOwned.find(name);
-  return it == kSweepOwned.end() ? std::string_view() : it->second;
+  const TrainOption* option = tasks::find_train_option(name);
+  return option == nullptr ? std::string_view() : option->sweep_owned;
 }
 
 std::vector<std::string> spec_keys() {
   std::vector<std::string> names;
-  for (const KeyInfo& k : kKeys) names.emplace_back(k.name);
+  for (const TrainOption* k : key_table()) names.emplace_back(k->name);
   return names;
 }
 
 // How a value reads in `hnn train`'s arguments.
-std::vector<std::string> arg_values(const KeyInfo& key, const ordered_json& v) {
+std::vector<std::string> arg_values(const TrainOption& key, const ordered_json& v) {
   switch (key.kind) {
-    case Kind::kHidden: {
+    case ValueKind::kHidden: {
       std::vector<std::string> widths;
       for (const ordered_json& w : v) widths.push_back(w.dump());
       return widths;
     }
-    case Kind::kColumns:
+    case ValueKind::kColumns:
       return {fmt::format("{}", fmt::join(v.get<std::vector<std::string>>(), ","))};
-    case Kind::kObject:
+    case ValueKind::kJsonObject:
       return {v.dump()};
     default:
       return {v.is_string() ? v.get<std::string>() : number_text(v)};
   }
 }
 
-std::string name_value(const KeyInfo& key, const ordered_json& v) {
+std::string name_value(const TrainOption& key, const ordered_json& v) {
   switch (key.kind) {
-    case Kind::kHidden:
+    case ValueKind::kHidden:
       return tasks::join_widths(v.get<std::vector<int>>());
-    case Kind::kFile:
+    case ValueKind::kFile:
       return folder_safe(fs::path(v.get<std::string>()).filename().string());
-    case Kind::kColumns:
+    case ValueKind::kColumns:
       return folder_safe(fmt::format("{}", fmt::join(v.get<std::vector<std::string>>(), "+")));
-    case Kind::kObject:
+    case ValueKind::kJsonObject:
       return folder_safe(v.dump());
     default:
       return folder_safe(v.is_string() ? v.get<std::string>() : number_text(v));
-  }
-}
-
-void apply_value(const KeyInfo& key, const ordered_json& v, tasks::RunOptions& o) {
-  switch (key.kind) {
-    case Kind::kModel:
-      o.model = tasks::parse_model(v.get<std::string>());
-      break;
-    case Kind::kSeed:
-      o.seed = v.get<std::uint64_t>();
-      break;
-    case Kind::kDtype:
-      o.dtype = tasks::parse_dtype(v.get<std::string>());
-      break;
-    case Kind::kPreset:
-      o.preset = tasks::parse_preset(v.get<std::string>());
-      break;
-    case Kind::kHidden:
-      o.hidden = v.get<std::vector<int>>();
-      break;
-    case Kind::kFile:
-      o.data_file = v.get<std::string>();
-      break;
-    case Kind::kObject:
-      o.task_settings = json::parse(v.dump());
-      break;
-    case Kind::kPositiveReal:
-      o.learning_rate = v.get<double>();
-      break;
-    case Kind::kLrSchedule:
-      o.lr_schedule = tasks::parse_lr_schedule(v.get<std::string>());
-      break;
-    default:
-      if (key.name == "steps") o.steps = v.get<int>();
-      if (key.name == "batch") o.batch_size = v.get<int>();
-      if (key.name == "checkpoint-every") o.checkpoint_every = v.get<long>();
   }
 }
 

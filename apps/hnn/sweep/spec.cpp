@@ -33,8 +33,10 @@ std::invalid_argument bad(std::string message) { return std::invalid_argument(me
 
 // ---- grids ---------------------------------------------------------------------------------
 
+using tasks::TrainOption;
+
 struct Axis {
-  const KeyInfo* key;
+  const TrainOption* key;
   std::vector<ordered_json> values;
 };
 
@@ -49,7 +51,7 @@ std::vector<Axis> axes_of(const ordered_json& grid) {
     };
     if (const std::string_view why = sweep_owned(name); !why.empty())
       throw prefix(std::string(why));
-    const KeyInfo* key = find_key(name);
+    const TrainOption* key = find_key(name);
     if (key == nullptr) {
       throw prefix(fmt::format("not an option of hnn train (the spec's keys: {}; grids, charts)",
                                known_keys()));
@@ -68,7 +70,7 @@ std::vector<Axis> axes_of(const ordered_json& grid) {
       }
       if (std::count(axis.values.begin(), axis.values.end(), axis.values.back()) > 1) {
         throw prefix(fmt::format("the value {} is listed twice{}", v.dump(),
-                                 key->kind == Kind::kHidden
+                                 key->kind == tasks::ValueKind::kHidden
                                      ? " (one value per model: [[16, 16]] is one 16-16 model)"
                                      : ""));
       }
@@ -132,7 +134,7 @@ std::string hash_tag(const std::string& text) {
 }
 
 // One combination of values as `hnn train` options, arguments, and a folder name.
-SweepRun build_run(const std::vector<std::pair<const KeyInfo*, ordered_json>>& chosen,
+SweepRun build_run(const std::vector<std::pair<const TrainOption*, ordered_json>>& chosen,
                    const fs::path& out, tasks::RunOptions& o) {
   std::map<std::string_view, ordered_json> by_name;
   for (const auto& [key, v] : chosen) by_name[key->name] = v;
@@ -140,27 +142,18 @@ SweepRun build_run(const std::vector<std::pair<const KeyInfo*, ordered_json>>& c
   o.task = by_name.at("task").get<std::string>();
   run.args = {o.task};
   std::vector<std::string> tags;
-  json data_settings = json::object();
-  for (const KeyInfo& key : key_table()) {
-    if (!by_name.count(key.name)) continue;
-    const ordered_json& v = by_name.at(key.name);
-    run.values[std::string(key.name)] = v;
-    if (key.name == "task") continue;
-    run.args.push_back("--" + std::string(key.name));
-    for (std::string& a : arg_values(key, v)) run.args.push_back(std::move(a));
-    if (key.name != "model") tags.push_back(fmt::format("{}={}", key.name, name_value(key, v)));
-    if (!key.data_setting.empty()) {
-      // The rollout loss's keys apply to every task that learns a field (its own check decides).
-      const bool any_task = key.name == "loss" || key.name == "horizon" || key.name == "integrator";
-      if (o.task != "data" && !any_task)
-        throw bad(
-            fmt::format("key '{}': applies to the data task only, not to '{}'", key.name, o.task));
-      data_settings[std::string(key.data_setting)] = v;
-      continue;
-    }
-    apply_value(key, v, o);
+  for (const TrainOption* key : key_table()) {
+    if (!by_name.count(key->name)) continue;
+    const ordered_json& v = by_name.at(key->name);
+    run.values[std::string(key->name)] = v;
+    if (key->name == "task") continue;
+    run.args.push_back("--" + std::string(key->name));
+    for (std::string& a : arg_values(*key, v)) run.args.push_back(std::move(a));
+    if (key->name != "model") tags.push_back(fmt::format("{}={}", key->name, name_value(*key, v)));
+    if (const std::string why = tasks::not_applicable(*key, o.task); !why.empty())
+      throw bad(fmt::format("key '{}': {}", key->name, why));
+    tasks::apply(*key, json::parse(v.dump()), o);
   }
-  o.task_settings.update(data_settings);  // as `hnn train` puts its data options over --settings
   std::string rest = tags.empty() ? "default" : fmt::format("{}", fmt::join(tags, ","));
   if (rest.size() > 160) rest = "h" + hash_tag(rest);
   run.name = fmt::format("{}/{}/{}", o.task, nn::to_string(o.model), rest);
@@ -173,7 +166,7 @@ template <typename F>
 void for_each_combination(const std::vector<Axis>& axes, F&& f) {
   std::vector<std::size_t> at(axes.size(), 0);
   while (true) {
-    std::vector<std::pair<const KeyInfo*, ordered_json>> chosen;
+    std::vector<std::pair<const TrainOption*, ordered_json>> chosen;
     for (std::size_t i = 0; i < axes.size(); ++i)
       chosen.emplace_back(axes[i].key, axes[i].values[at[i]]);
     f(chosen);
@@ -333,8 +326,8 @@ SweepPlan expand(const ordered_json& spec, const std::string& where, const fs::p
   for (const SweepRun& r : plan.runs) ++count[r.name];
   for (SweepRun& r : plan.runs)
     if (count[r.name] > 1) r.name += "~" + hash_tag(r.settings.dump());
-  for (const KeyInfo& k : key_table())
-    if (used_keys.count(std::string(k.name))) plan.keys.emplace_back(k.name);
+  for (const TrainOption* k : key_table())
+    if (used_keys.count(std::string(k->name))) plan.keys.emplace_back(k->name);
   try {
     plan.charts = checked_charts(spec, used_keys);
   } catch (const std::invalid_argument& e) {

@@ -1,0 +1,344 @@
+// The table of `hnn train`'s options (train_options.h) and apply(), where each lands.
+
+#include "tasks/train_options.h"
+
+#include <fmt/format.h>
+
+#include <limits>
+
+#include "tasks/error.h"
+#include "tasks/train/rollout_step.h"
+
+namespace hnn::tasks {
+
+using nlohmann::json;
+
+namespace {
+
+constexpr long long kIntMax = std::numeric_limits<int>::max();
+constexpr std::string_view kDataGroup = "The data task (hnn train data --data FILE)";
+constexpr std::string_view kRolloutGroup =
+    "Training through an integrator (every task that learns a field)";
+
+std::vector<std::string> split_names() { return {"auto", "trajectories", "time"}; }
+
+// In --help's order. A sweep key's rank is its place in run folder names (spring/hnn/seed=1,
+// steps=200): fixed, so that sweeps written before keep their folders.
+const TrainOption kOptions[] = {
+    {.name = "task",
+     .kind = ValueKind::kTask,
+     .help = "Task: {} (required unless --resume)",
+     .sweep_rank = 0,
+     .lands = Lands::kTask,
+     .key = "task"},
+    {.name = "model",
+     .kind = ValueKind::kChoice,
+     .help = "hnn, baseline, dhnn (the dissipative HNN: H and a dissipation potential D) or lnn "
+             "(the Lagrangian NN: L(q, dq/dt))",
+     .default_shown = "hnn",
+     .sweep_rank = 1,
+     .lands = Lands::kModel,
+     .key = "model",
+     .choices = model_names,
+     .noun = "model"},
+    {.name = "steps",
+     .kind = ValueKind::kInt,
+     .help = "Training steps (default: the paper's)",
+     .sweep_rank = 6,
+     .lands = Lands::kSteps,
+     .key = "steps",
+     .min = 1,
+     .max = kIntMax},
+    {.name = "seed",
+     .kind = ValueKind::kSeed,
+     .help = "Seed of the data, initialisation and batches",
+     .default_shown = "0",
+     .sweep_rank = 2,
+     .lands = Lands::kSeed,
+     .key = "seed"},
+    {.name = "dtype",
+     .kind = ValueKind::kChoice,
+     .help = "float or double",
+     .default_shown = "double",
+     .sweep_rank = 3,
+     .lands = Lands::kDtype,
+     .key = "dtype",
+     .choices = dtype_names,
+     .noun = "dtype"},
+    {.name = "threads",
+     .kind = ValueKind::kInt,
+     .help = "Threads for matrix products",
+     .default_shown = "2",
+     .with_resume = true,
+     .sweep_owned = "set by hnn sweep for every run (--threads-per-run)",
+     .lands = Lands::kThreads,
+     .key = "threads",
+     .recorded_default = "2",
+     .min = 1,
+     .max = 256},
+    {.name = "preset",
+     .kind = ValueKind::kChoice,
+     .help = "Model widths: paper (the paper's 200-200) or lean (the smallest within the noise of "
+             "paper's accuracy); --hidden overrides either",
+     .default_shown = "paper",
+     .sweep_rank = 4,
+     .lands = Lands::kPreset,
+     .key = "preset",
+     .recorded_default = R"("paper")",  // runs from before the presets
+     .choices = preset_names,
+     .noun = "preset"},
+    {.name = "batch",
+     .kind = ValueKind::kInt,
+     .help = "Minibatch size (0: full batch; default: the paper's)",
+     .sweep_rank = 7,
+     .lands = Lands::kBatchSize,
+     .key = "batch_size",
+     .min = 0,
+     .max = kIntMax},
+    {.name = "hidden",
+     .kind = ValueKind::kHidden,
+     .help = "Hidden widths, e.g. --hidden 200 200",
+     .sweep_rank = 5,
+     .lands = Lands::kHidden,
+     .key = "hidden"},
+    {.name = "lr",
+     .kind = ValueKind::kPositiveReal,
+     .help = "Adam learning rate (default 1e-3)",
+     .sweep_rank = 8,
+     .lands = Lands::kLearningRate,
+     .key = "learning_rate"},
+    {.name = "lr-schedule",
+     .kind = ValueKind::kChoice,
+     .help = "constant (the default) or cosine: decay from --lr towards 0 at the last step",
+     .sweep_rank = 9,
+     .lands = Lands::kLrSchedule,
+     .key = "lr_schedule",
+     .recorded_default = R"("constant")",  // runs from before the schedules
+     .choices = lr_schedule_names,
+     .noun = "learning-rate schedule"},
+    {.name = "data",
+     .kind = ValueKind::kFile,
+     .help = "The data task's file, or real-pendulum's measured data in its format",
+     .sweep_rank = 10,
+     .lands = Lands::kDataFile,
+     .key = "data_file",
+     .recorded_default = R"("")"},
+    {.name = "out",
+     .kind = ValueKind::kFolder,
+     .help = "Run folder (default runs/TASK/MODEL)",
+     .sweep_owned = "set by hnn sweep (OUT/runs/<run>)",
+     .lands = Lands::kOut},
+    {.name = "quiet",
+     .kind = ValueKind::kFlag,
+     .help = "No progress output",
+     .with_resume = true,
+     .sweep_owned = "hnn sweep runs quietly",
+     .lands = Lands::kQuiet},
+    {.name = "settings",
+     .kind = ValueKind::kJsonObject,
+     .help = "The task's own settings as a JSON object, e.g. pixel-pendulum's '{\"trials\": 20, "
+             "\"ae_hidden\": 64}' (see its metrics.json's \"pixel\")",
+     .sweep_rank = 11,
+     .lands = Lands::kTaskSettings,
+     .key = "task_settings",
+     .recorded_default = "{}"},
+    {.name = "checkpoint-every",
+     .kind = ValueKind::kInt,
+     .help = "Steps between checkpoints in OUT/checkpoint (default: a tenth of the steps)",
+     .with_resume = true,
+     .sweep_rank = 12,
+     .lands = Lands::kCheckpointEvery,
+     .min = 1,
+     .max = kIntMax},
+    {.name = "resume",
+     .kind = ValueKind::kRunFolder,
+     .help = "Continue the interrupted run in this folder from its last checkpoint",
+     .with_resume = true,
+     .sweep_owned = "hnn sweep resumes interrupted runs by itself",
+     .lands = Lands::kResume},
+    {.name = "coords",
+     .kind = ValueKind::kColumns,
+     .help = "Coordinate columns q (names or 0-based indices, comma-separated)",
+     .group = kDataGroup,
+     .sweep_rank = 13,
+     .applies_to = AppliesTo::kDataTask,
+     .key = "coords"},
+    {.name = "momenta",
+     .kind = ValueKind::kColumns,
+     .help = "Momentum columns p, one per coordinate",
+     .group = kDataGroup,
+     .sweep_rank = 14,
+     .applies_to = AppliesTo::kDataTask,
+     .key = "momenta"},
+    {.name = "velocities",
+     .kind = ValueKind::kColumns,
+     .help = "Velocity columns dq/dt instead of momenta (unit masses assumed)",
+     .group = kDataGroup,
+     .sweep_rank = 15,
+     .applies_to = AppliesTo::kDataTask,
+     .key = "velocities"},
+    {.name = "derivatives",
+     .kind = ValueKind::kColumns,
+     .help = "Columns of dx/dt, one per state column (default: finite differences)",
+     .group = kDataGroup,
+     .sweep_rank = 16,
+     .applies_to = AppliesTo::kDataTask,
+     .key = "derivatives"},
+    {.name = "time",
+     .kind = ValueKind::kText,
+     .help = "Time column (default: t, else time)",
+     .group = kDataGroup,
+     .sweep_rank = 17,
+     .applies_to = AppliesTo::kDataTask,
+     .key = "time"},
+    {.name = "trajectory",
+     .kind = ValueKind::kText,
+     .help = "Trajectory id column (default: trajectory, else trial; none: one trajectory)",
+     .group = kDataGroup,
+     .sweep_rank = 18,
+     .applies_to = AppliesTo::kDataTask,
+     .key = "trajectory"},
+    {.name = "split",
+     .kind = ValueKind::kChoice,
+     .help = "Test split: auto, trajectories or time",
+     .group = kDataGroup,
+     .sweep_rank = 19,
+     .applies_to = AppliesTo::kDataTask,
+     .key = "split",
+     .choices = split_names,
+     .noun = "split"},
+    {.name = "test-fraction",
+     .kind = ValueKind::kFraction,
+     .help = "Share of the trajectories (or of each one's rows) held out (default 0.2)",
+     .group = kDataGroup,
+     .sweep_rank = 20,
+     .applies_to = AppliesTo::kDataTask,
+     .key = "test_fraction"},
+    {.name = "hamiltonian",
+     .kind = ValueKind::kText,
+     .help = "A known H over the state's column names, for the energy metric",
+     .group = kDataGroup,
+     .sweep_rank = 21,
+     .applies_to = AppliesTo::kDataTask,
+     .key = "hamiltonian"},
+    {.name = "loss",
+     .kind = ValueKind::kChoice,
+     .help = "derivative (dx/dt targets, the default) or rollout (from states alone: the model's "
+             "field integrated over --horizon sampling intervals)",
+     .group = kRolloutGroup,
+     .sweep_rank = 22,
+     .applies_to = AppliesTo::kFieldTasks,
+     .key = "loss",
+     .choices = loss_names,
+     .noun = "loss"},
+    {.name = "horizon",
+     .kind = ValueKind::kInt,
+     .help = "Sampling intervals per rollout window (default 1)",
+     .group = kRolloutGroup,
+     .sweep_rank = 23,
+     .applies_to = AppliesTo::kFieldTasks,
+     .key = "horizon",
+     .min = 1,
+     .max = 1000,
+     .range_in_help = true},
+    {.name = "integrator",
+     .kind = ValueKind::kChoice,
+     .help = "The rollout loss's integrator: leapfrog, yoshida4, midpoint or rk4 (default)",
+     .group = kRolloutGroup,
+     .sweep_rank = 24,
+     .applies_to = AppliesTo::kFieldTasks,
+     .key = "integrator",
+     .choices = rollout_integrator_names,
+     .noun = "integrator"},
+    {.name = "dt",
+     .kind = ValueKind::kPositiveReal,
+     .help = "The rollout loss's step (default: the sampling interval; it must divide it)",
+     .group = kRolloutGroup,
+     .sweep_rank = 25,
+     .applies_to = AppliesTo::kFieldTasks,
+     .key = "dt"},
+};
+
+}  // namespace
+
+std::span<const TrainOption> train_options() { return kOptions; }
+
+const TrainOption* find_train_option(std::string_view name) {
+  for (const TrainOption& option : kOptions)
+    if (option.name == name) return &option;
+  return nullptr;
+}
+
+std::vector<std::string> loss_names() { return {"derivative", "rollout"}; }
+std::vector<std::string> lr_schedule_names() { return {"constant", "cosine"}; }
+
+std::string not_applicable(const TrainOption& option, const std::string& task) {
+  if (option.applies_to != AppliesTo::kDataTask || task == "data") return "";
+  return fmt::format("applies to the data task only, not to '{}'", task);
+}
+
+void apply(const TrainOption& option, const json& v, RunOptions& o) {
+  switch (option.lands) {
+    case Lands::kTask:
+      o.task = v.get<std::string>();
+      return;
+    case Lands::kModel:
+      o.model = parse_model(v.get<std::string>());
+      return;
+    case Lands::kSeed:
+      o.seed = v.get<std::uint64_t>();
+      return;
+    case Lands::kDtype:
+      o.dtype = parse_dtype(v.get<std::string>());
+      return;
+    case Lands::kPreset:
+      o.preset = parse_preset(v.get<std::string>());
+      return;
+    case Lands::kThreads:
+      o.threads = v.get<int>();
+      return;
+    case Lands::kSteps:
+      o.steps = v.get<int>();
+      return;
+    case Lands::kBatchSize:
+      o.batch_size = v.get<int>();
+      return;
+    case Lands::kHidden:
+      o.hidden = v.get<std::vector<int>>();
+      return;
+    case Lands::kLearningRate:
+      o.learning_rate = v.get<double>();
+      return;
+    case Lands::kLrSchedule:
+      o.lr_schedule = parse_lr_schedule(v.get<std::string>());
+      return;
+    case Lands::kDataFile:
+      o.data_file = v.get<std::string>();
+      return;
+    case Lands::kOut:
+      o.out = v.get<std::string>();
+      return;
+    case Lands::kQuiet:
+      o.quiet = v.get<bool>();
+      return;
+    case Lands::kTaskSettings: {
+      // The keys already set by their own options stay (the data task's, the rollout loss's).
+      json settings = v;
+      if (settings.is_object()) settings.update(o.task_settings);
+      o.task_settings = std::move(settings);
+      return;
+    }
+    case Lands::kCheckpointEvery:
+      o.checkpoint_every = v.get<long>();
+      return;
+    case Lands::kResume:
+      o.out = v.get<std::string>();
+      o.resume = true;
+      return;
+    case Lands::kTaskSetting:
+      o.task_settings[std::string(option.key)] = v;
+      return;
+  }
+}
+
+}  // namespace hnn::tasks
