@@ -62,10 +62,8 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 }
 
 LoopOptions loop_options(const RunOptions& o, const RunSettings& s, const RunFolder& folder) {
-  return {.steps = s.train.steps,
-          .lr_schedule = s.train.lr_schedule,
-          .record_every = s.train.record_every,
-          .quiet = o.quiet,
+  // Steps, schedule and loss-curve interval: the run's own (with_train_config, tasks/task.h).
+  return {.quiet = o.quiet,
           .label = fmt::format("{} {}", s.task, nn::to_string(s.model)),
           .checkpoint_dir = folder.checkpoint_dir(),
           .checkpoint_every = o.checkpoint_every.value_or(0),

@@ -6,6 +6,13 @@
 
 namespace hnn::tasks {
 
+LoopOptions with_train_config(LoopOptions loop, const TrainConfig& config) {
+  loop.steps = config.steps;
+  loop.lr_schedule = config.lr_schedule;
+  loop.record_every = config.record_every;
+  return loop;
+}
+
 void Task::check_task_settings(const nlohmann::json& settings) const {
   HNN_TASKS_CHECK(settings.empty(), "task '{}' has no settings of its own, got {}", name(),
                   settings.dump());

@@ -28,11 +28,16 @@ struct RolloutRequest {
   int points = 200, trajectories = 5;
 };
 
+/// `loop` with the steps, learning-rate schedule and loss-curve interval of `config`: every run
+/// trains with its own settings' (TaskRun::train), whoever made the loop.
+LoopOptions with_train_config(LoopOptions loop, const TrainConfig& config);
+
 /// One run of a task: its data (built when the run is opened) and its model.
 class TaskRun {
  public:
   virtual ~TaskRun() = default;
-  /// Trains a fresh model, initialised from the run's seed, with the training loop.
+  /// Trains a fresh model, initialised from the run's seed, with the training loop: its steps,
+  /// schedule and loss-curve interval from the run's settings (with_train_config).
   virtual TrainResult train(const LoopOptions& loop) = 0;
   /// The trained model's parameters, in the run's dtype (nn's parameter file).
   virtual void save(const std::filesystem::path& params) const = 0;

@@ -29,7 +29,7 @@
 #include "tasks/pixel/model.h"
 #include "tasks/train/field_objective.h"
 #include "tasks/train/rollout_objective.h"
-#include "tasks/train/rollout_step.h"
+#include "tasks/integrate/integrator_step.h"
 
 namespace {
 

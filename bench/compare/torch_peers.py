@@ -110,7 +110,7 @@ def rollout_parts(x, horizon):
 
 
 def leapfrog(field, x, h):
-    """Kick-drift-kick on the field's p- and q-parts (tasks/train/rollout_step.cpp's)."""
+    """Kick-drift-kick on the field's p- and q-parts (tasks/integrate/integrator_step.cpp's)."""
     n = x.shape[1] // 2
     half = h * 0.5
     q = x[:, :n]

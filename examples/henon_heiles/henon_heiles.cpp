@@ -9,6 +9,8 @@
 #include <nn/hnn.h>
 #include <physics/autodiff/autodiff_system.h>
 #include <physics/integrator.h>
+#include <tasks/evaluate/energy_errors.h>
+#include <tasks/evaluate/loss_stats.h>
 #include <tasks/evaluate/rollouts.h>
 #include <tasks/field/field_model_run.h>
 #include <tasks/field/field_task.h>

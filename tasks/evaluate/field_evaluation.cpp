@@ -7,8 +7,10 @@
 
 #include "autodiff/tape.h"
 #include "nn/hnn.h"
-#include "tasks/report/csv_cell.h"
+#include "tasks/evaluate/energy_errors.h"
+#include "tasks/evaluate/state_errors.h"
 #include "tasks/report/json_values.h"
+#include "tasks/report/rollout_csv.h"
 
 namespace hnn::tasks {
 
@@ -115,48 +117,22 @@ FieldEvaluation evaluate_field_model(const nn::DynamicsModel<double>& model, con
 
 namespace {
 
-std::string rollout_row(const Rollouts& r, std::size_t i, std::size_t k) {
-  const Eigen::Index row = Eigen::Index(k), traj = Eigen::Index(i);
-  std::string line = fmt::format("{},{:.9g}", i, r.t[k]);
-  for (Eigen::Index c = 0; c < r.truth[i].cols(); ++c) line += "," + csv_cell(r.truth[i](row, c));
-  for (Eigen::Index c = 0; c < r.pred[i].cols(); ++c) line += "," + csv_cell(r.pred[i](row, c));
-  line += "," + csv_cell(r.true_energy(traj, row)) + "," + csv_cell(r.pred_energy(traj, row)) + ",";
-  if (r.learned_h.size() > 0) line += csv_cell(r.learned_h(traj, row));
-  return line + "\n";
+// The rows of a matrix, or empty vectors for an empty matrix (no learned H).
+Eigen::VectorXd row_or_empty(const Eigen::MatrixXd& m, std::size_t i) {
+  return m.size() > 0 ? Eigen::VectorXd(m.row(Eigen::Index(i)).transpose()) : Eigen::VectorXd();
 }
 
 }  // namespace
 
 std::string rollout_csv(const Rollouts& r) {
-  const Eigen::Index dim = r.truth.empty() ? 0 : r.truth[0].cols();
-  std::string csv = "traj,t";
-  for (const char* which : {"true", "pred"})
-    for (Eigen::Index k = 0; k < dim; ++k) csv += fmt::format(",{}_{}", which, k);
-  csv += ",true_energy,pred_energy,learned_h\n";
-  for (std::size_t i = 0; i < r.truth.size(); ++i)
-    for (std::size_t k = 0; k < r.t.size(); ++k) csv += rollout_row(r, i, k);
-  return csv;
-}
-
-namespace {
-
-// One CSV block per source: source,traj,t,x_0..x_{d-1},energy,learned_h
-void append_paths(std::string& csv, std::string_view source, const physics::Trajectory& path,
-                  const physics::System& truth, const nn::Hnn<double>* hnn) {
-  for (Eigen::Index row = 0; row < path.states.front().rows(); ++row) {
-    const Eigen::MatrixXd states = path.path(row);
-    const Eigen::VectorXd energy = truth.energy_batch(physics::Batch(states));
-    Eigen::VectorXd h;
-    if (hnn) h = hnn->energy(physics::Batch(states)).col(0);
-    for (Eigen::Index k = 0; k < states.rows(); ++k) {
-      csv += fmt::format("{},{},{:.9g}", source, row, path.t[std::size_t(k)]);
-      for (Eigen::Index c = 0; c < states.cols(); ++c) csv += fmt::format(",{:.12g}", states(k, c));
-      csv += fmt::format(",{:.12g},{}\n", energy(k), hnn ? fmt::format("{:.12g}", h(k)) : "");
-    }
+  ComparisonCsv csv(r.truth.empty() ? 0 : r.truth[0].cols());
+  const Eigen::VectorXd t = as_vector(r.t);
+  for (std::size_t i = 0; i < r.truth.size(); ++i) {
+    csv.add(i, t, r.truth[i], r.pred[i], row_or_empty(r.true_energy, i),
+            row_or_empty(r.pred_energy, i), row_or_empty(r.learned_h, i));
   }
+  return csv.str();
 }
-
-}  // namespace
 
 std::string rollout_paths_csv(const physics::System& truth, const nn::DynamicsModel<double>& model,
                               std::string_view model_name, const Batch& x0,
@@ -164,13 +140,18 @@ std::string rollout_paths_csv(const physics::System& truth, const nn::DynamicsMo
   const physics::VectorField learned = [&model](double, const Batch& x, Batch& dxdt) {
     dxdt = model.field(x);
   };
-  std::string csv = "source,traj,t";
-  for (Eigen::Index c = 0; c < x0.cols(); ++c) csv += fmt::format(",x_{}", c);
-  csv += ",energy,learned_h\n";
-  append_paths(csv, "true", integrator.integrate(truth.field(), x0, t), truth, nullptr);
-  append_paths(csv, model_name, integrator.integrate(learned, x0, t), truth,
-               dynamic_cast<const nn::Hnn<double>*>(&model));
-  return csv;
+  const auto* hnn = dynamic_cast<const nn::Hnn<double>*>(&model);
+  PathsCsv csv(numbered_columns("x", x0.cols()));
+  const auto add = [&](std::string_view source, const physics::Trajectory& path, bool with_h) {
+    for (Eigen::Index row = 0; row < path.states.front().rows(); ++row) {
+      const Batch states = path.path(row);
+      csv.add(source, std::size_t(row), as_vector(path.t), states, truth.energy_batch(states),
+              with_h ? Eigen::VectorXd(hnn->energy(states).col(0)) : Eigen::VectorXd());
+    }
+  };
+  add("true", integrator.integrate(truth.field(), x0, t), false);
+  add(model_name, integrator.integrate(learned, x0, t), hnn != nullptr);
+  return csv.str();
 }
 
 }  // namespace hnn::tasks

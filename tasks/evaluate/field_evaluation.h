@@ -9,6 +9,7 @@
 #include "nn/dynamics.h"
 #include "physics/integrator.h"
 #include "tasks/data/dataset.h"
+#include "tasks/evaluate/loss_stats.h"
 #include "tasks/evaluate/rollouts.h"
 
 namespace hnn::tasks {

@@ -2,19 +2,48 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "physics/integrator.h"
-#include "tasks/report/csv_cell.h"
+#include "tasks/evaluate/state_errors.h"
 #include "tasks/report/json_values.h"
+#include "tasks/report/rollout_csv.h"
 
 namespace hnn::tasks {
 
+using nlohmann::json;
+
 namespace {
 
-// As the energy rollouts (rollouts.cpp): a field that needs more steps than this is reported
-// as failed rather than integrated for hours.
-constexpr long kMaxLearnedSteps = 100'000;
+// The held-out error along stretches looks at this many stretches of each split at most.
+constexpr std::size_t kMaxStretches = 200;
+
+// Mean, standard deviation and standard error of the finite per-stretch values.
+json spread(const std::string& name, std::vector<double> v) {
+  std::erase_if(v, [](double x) { return !std::isfinite(x); });
+  const double n = double(v.size());
+  double mean = v.empty() ? NAN : 0, var = 0;
+  for (double x : v) mean += x / n;
+  for (double x : v) var += (x - mean) * (x - mean) / std::max(1.0, n - 1);
+  return {{name, number(mean)},
+          {name + "_std", number(std::sqrt(var))},
+          {name + "_se", number(std::sqrt(var / n))}};
+}
+
+// The first `kMaxStretches` of `all`.
+std::vector<Stretch> first_stretches(const std::vector<Stretch>& all) {
+  return {all.begin(), all.begin() + std::ptrdiff_t(std::min(kMaxStretches, all.size()))};
+}
+
+// The truth stepped by leapfrog, one step per sampling interval.
+Predictor leapfrog_predictor(const physics::System& truth) {
+  return [&truth](const Batch& x0, const Eigen::VectorXd& t) {
+    const double interval = t.size() > 1 ? t(1) - t(0) : 1.0;
+    const auto integrator = physics::make_integrator("leapfrog", {.dt = interval * (1 + 1e-9)});
+    return integrator->integrate(truth.field(), x0, {t.data(), t.data() + t.size()}).states;
+  };
+}
 
 struct Summary {
   double mean = NAN, se = NAN;
@@ -34,22 +63,17 @@ Summary summarise(const std::vector<double>& values) {
   return s;
 }
 
-// Rolls the model out in its own units from the stretch's first state at its own times.
-void roll_out(const LearnedField& model, const Units& units, HeldOutRollout& r) {
-  const Batch z0 = units.to_model(Batch(r.truth.topRows(1)));
-  std::vector<double> t(std::size_t(r.t.size()));
-  for (Eigen::Index k = 0; k < r.t.size(); ++k) t[std::size_t(k)] = (r.t(k) - r.t(0)) / units.time;
-  const auto dopri = physics::make_integrator(
-      "dopri5", {.rtol = 1e-9, .atol = 1e-12, .max_steps = kMaxLearnedSteps});
-  try {
-    const Batch z = dopri->integrate(model.field, z0, t).path(0);
-    r.pred = units.to_file(z);
-    if (model.hamiltonian) r.learned_h = model.hamiltonian(z) * units.energy_to_file();
-  } catch (const physics::IntegrationError& e) {
+// The predicted path `z` (model units) as the rollout r reports it, or its failure.
+void in_file_units(const LearnedField& model, const Units& units, const Batch& z,
+                   const std::string& failure, HeldOutRollout& r) {
+  if (!failure.empty()) {
     r.failed = true;
-    r.failure = fmt::format("{}: {}", r.where, e.what());
+    r.failure = fmt::format("{}: {}", r.where, failure);
     r.pred.setConstant(r.truth.rows(), r.truth.cols(), NAN);
+    return;
   }
+  r.pred = units.to_file(z);
+  if (model.hamiltonian) r.learned_h = model.hamiltonian(z) * units.energy_to_file();
 }
 
 // The first time since the start at which the relative state error passes the threshold.
@@ -66,7 +90,7 @@ void valid_time(const Units& units, double threshold, HeldOutRollout& r) {
   r.censored = true;
 }
 
-nlohmann::json summary_json(const std::string& name, const std::vector<double>& values) {
+json summary_json(const std::string& name, const std::vector<double>& values) {
   const Summary s = summarise(values);
   return {{name, number(s.mean)}, {name + "_se", number(s.se)}, {name + "_count", values.size()}};
 }
@@ -79,6 +103,52 @@ double mean_log_error(const Units& units, const HeldOutRollout& r) {
 }
 
 }  // namespace
+
+json stretch_errors(const std::string& prefix, const std::vector<Stretch>& stretches,
+                    const std::vector<Batch>& paths, int per_body) {
+  std::vector<double> mse, position;
+  for (std::size_t i = 0; i < stretches.size(); ++i) {
+    const Batch e = paths[i] - stretches[i].x;
+    const Eigen::Index n = e.cols() / 2, bodies = n / per_body;
+    mse.push_back(e.rows() > 1 ? e.bottomRows(e.rows() - 1).array().square().mean() : 0.0);
+    if (!std::isfinite(mse.back())) mse.back() = NAN;
+    double sum = 0;
+    for (Eigen::Index k = 0; k < e.rows(); ++k)
+      for (Eigen::Index b = 0; b < bodies; ++b)
+        sum += e.row(k).segment(b * per_body, per_body).norm();
+    position.push_back(std::isfinite(sum) ? sum / double(e.rows() * bodies) : NAN);
+  }
+  json j = spread(prefix + "state_mse", mse);
+  j.update(spread(prefix + "position_error", position));
+  return j;
+}
+
+json held_out_stretch_metrics(const nn::DynamicsModel<double>& model,
+                              const SplitStretches& stretches,
+                              const StretchMetricsOptions& options) {
+  const std::vector<Stretch> test = first_stretches(stretches.test);
+  const std::vector<Stretch> train = first_stretches(stretches.train);
+  const Predictor predict = model_predictor(model, options.stepping);
+  const PredictedPaths on_test = predict_paths(test, predict);
+  json m = stretch_errors("stretch_", test, on_test.paths, options.per_body);
+  m["stretch_failures"] = on_test.failed();
+  const PredictedPaths on_train = predict_paths(train, predict);
+  const json fit = stretch_errors("train_stretch_", train, on_train.paths, options.per_body);
+  m["train_stretch_position_error"] = fit["train_stretch_position_error"];
+  m["train_stretch_state_mse"] = fit["train_stretch_state_mse"];
+  m["train_stretch_failures"] = on_train.failed();
+  m["stretch_predictor"] = options.stepping.describe();
+  m["n_stretches"] = test.size();
+  if (options.truth == nullptr) return m;
+  const PredictedPaths by_leapfrog = predict_paths(test, leapfrog_predictor(*options.truth));
+  const json truth = stretch_errors("truth_leapfrog_", test, by_leapfrog.paths, options.per_body);
+  for (const char* key : {"position_error", "position_error_std", "state_mse"}) {
+    const std::string name = std::string("truth_leapfrog_") + key;
+    m[name] = truth[name];
+  }
+  m["truth_leapfrog_failures"] = by_leapfrog.failed();
+  return m;
+}
 
 HeldOutEvaluation evaluate_held_out(const LearnedField& model, const Units& units,
                                     const std::vector<HeldOut>& held_out, Eigen::Index coordinates,
@@ -94,12 +164,18 @@ HeldOutEvaluation evaluate_held_out(const LearnedField& model, const Units& unit
     h_spread = std::sqrt((h.array() - h.mean()).square().sum() /
                          double(std::max<Eigen::Index>(1, h.size() - 1)));
   }
-  for (const HeldOut& stretch : held_out) {
+  std::vector<Stretch> in_model_units;
+  for (const HeldOut& h : held_out)
+    in_model_units.push_back({(h.t.array() - h.t(0)) / units.time, units.to_model(h.x)});
+  const PredictedPaths z =
+      predict_paths(in_model_units, dopri5_predictor(model.field), /*batch=*/false);
+  for (std::size_t i = 0; i < held_out.size(); ++i) {
+    const HeldOut& stretch = held_out[i];
     HeldOutRollout r{.trajectory = stretch.trajectory,
                      .where = stretch.where,
                      .t = stretch.t,
                      .truth = stretch.x};
-    roll_out(model, units, r);
+    in_file_units(model, units, z.paths[i], z.failures[i], r);
     valid_time(units, options.threshold, r);
     if (options.truth != nullptr) {
       r.true_energy = options.truth->energy_batch(r.truth);
@@ -150,29 +226,13 @@ HeldOutEvaluation evaluate_held_out(const LearnedField& model, const Units& unit
   return e;
 }
 
-namespace {
-
-double at(const Eigen::VectorXd& v, Eigen::Index k) { return v.size() > k ? v(k) : NAN; }
-
-}  // namespace
-
 std::string held_out_csv(const HeldOutEvaluation& e) {
-  const Eigen::Index dim = e.rollouts.empty() ? 0 : e.rollouts[0].truth.cols();
-  std::string csv = "traj,t";
-  for (const char* which : {"true", "pred"})
-    for (Eigen::Index c = 0; c < dim; ++c) csv += fmt::format(",{}_{}", which, c);
-  csv += ",true_energy,pred_energy,learned_h\n";
+  ComparisonCsv csv(e.rollouts.empty() ? 0 : e.rollouts[0].truth.cols(), {.times = 12});
   for (std::size_t i = 0; i < e.rollouts.size(); ++i) {
     const HeldOutRollout& r = e.rollouts[i];
-    for (Eigen::Index k = 0; k < r.t.size(); ++k) {
-      csv += fmt::format("{},{:.12g}", i, r.t(k));
-      for (Eigen::Index c = 0; c < dim; ++c) csv += "," + csv_cell(r.truth(k, c));
-      for (Eigen::Index c = 0; c < dim; ++c) csv += "," + csv_cell(r.pred(k, c));
-      csv += fmt::format(",{},{},{}\n", csv_cell(at(r.true_energy, k)),
-                         csv_cell(at(r.pred_energy, k)), csv_cell(at(r.learned_h, k)));
-    }
+    csv.add(i, r.t, r.truth, r.pred, r.true_energy, r.pred_energy, r.learned_h);
   }
-  return csv;
+  return csv.str();
 }
 
 }  // namespace hnn::tasks

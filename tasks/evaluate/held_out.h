@@ -1,18 +1,43 @@
 #pragma once
-// Evaluation without a known H: the learned model rolled out from the first state of each
-// held-out stretch over the stretch's own times and compared with the measured states. The
-// rollouts are integrated in the model's units (so tolerances mean the same at any data scale)
-// and reported in the file's.
+// The held-out evaluator: a model predicted from the first state of each held-out stretch over
+// the stretch's own times (stretch_predictions.h) and compared with the stretch. The tasks on
+// simulated trajectories report SRNN's errors (held_out_stretch_metrics); the data task, whose
+// model trains in standardised units, reports in the file's units (evaluate_held_out).
 
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
 #include "tasks/data/measured_dataset.h"
+#include "tasks/data/stretch.h"
 #include "tasks/data/units.h"
 #include "tasks/evaluate/rollouts.h"
+#include "tasks/evaluate/stretch_predictions.h"
 
 namespace hnn::tasks {
+
+/// The held-out error of predicted paths against the stretches: state MSE over the points after
+/// the start, and the position error (SRNN's measure: the Euclidean distance of each body's
+/// position, averaged over the bodies and over every sampled time, the start included), each
+/// with `_std` and `_se` over the stretches; keys start with `prefix`.
+nlohmann::json stretch_errors(const std::string& prefix, const std::vector<Stretch>& stretches,
+                              const std::vector<Batch>& paths, int per_body);
+
+struct StretchMetricsOptions {
+  int per_body = 1;                        ///< position coordinates per body
+  StretchStepping stepping{};              ///< how the model steps
+  const physics::System* truth = nullptr;  ///< the true system, when there is one
+};
+
+/// The model along at most 200 test stretches (stretch_errors with prefix "stretch_", and
+/// "stretch_failures", "stretch_predictor", "n_stretches"), the same on as many training
+/// stretches ("train_stretch_position_error", "train_stretch_state_mse",
+/// "train_stretch_failures": the gap to the test figure is what generalisation costs), and with
+/// a truth, the truth by leapfrog with one step per interval ("truth_leapfrog_..."): what the
+/// sampling alone costs a symplectic integrator.
+nlohmann::json held_out_stretch_metrics(const nn::DynamicsModel<double>& model,
+                                        const SplitStretches& stretches,
+                                        const StretchMetricsOptions& options);
 
 struct HeldOutRollout {
   double trajectory = 0;
@@ -47,8 +72,10 @@ struct HeldOutEvaluation {
   nlohmann::json metrics;
 };
 
-/// `model` works in `units`: model.field(z) = dz/dt' with z = units.to_model(x).
-/// `train_z` (the training states in the model's units) sets the scale of the learned H.
+/// The data task's: `model` works in `units` (model.field(z) = dz/dt' with z =
+/// units.to_model(x)) and is integrated there by dopri5, each stretch alone, so that tolerances
+/// mean the same at any data scale; errors are reported in the file's units. `train_z` (the
+/// training states in the model's units) sets the scale of the learned H.
 HeldOutEvaluation evaluate_held_out(const LearnedField& model, const Units& units,
                                     const std::vector<HeldOut>& held_out, Eigen::Index coordinates,
                                     const Batch& train_z, const HeldOutOptions& options = {});

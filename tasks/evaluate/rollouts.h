@@ -1,6 +1,7 @@
 #pragma once
-// The shared evaluator: final losses with standard errors, and rollouts of the true and learned
-// fields from the same initial states for the energy metric and the charts.
+// Rollouts of the true and learned fields from the same initial states (or along measured paths),
+// for the metrics (energy_errors.h, state_errors.h) and the charts. Losses over a split:
+// loss_stats.h.
 
 #include <cstdint>
 #include <functional>
@@ -9,7 +10,6 @@
 #include <vector>
 
 #include "nn/dynamics.h"
-#include "nn/loss.h"
 #include "physics/system.h"
 
 namespace hnn::tasks {
@@ -39,14 +39,6 @@ struct RolloutConfig {
   /// errors over the whole span say little); they need not be on the grid of `points`.
   std::vector<double> horizons{};
 };
-
-/// Mean squared error of the model's field over a whole split (all N points, all D components),
-/// with the reference implementation's standard error: std(N x D squared errors, n - 1
-/// normalised) / sqrt(N), the convention of the paper's Table 1. Throws on an empty split.
-nn::MeanStderr loss_stats(const nn::DynamicsModel<double>& model, const Batch& x,
-                          const Batch& dxdt);
-/// The same for any field (a model in other units, say).
-nn::MeanStderr loss_stats(const physics::VectorField& field, const Batch& x, const Batch& dxdt);
 
 // Note [Perturbed truth]: how close a perfect model could come. The true system integrated from
 // starts perturbed by 1e-4 drifts from the true rollout as the system amplifies the difference
@@ -100,51 +92,5 @@ Rollouts make_rollouts(const physics::System& truth, const LearnedField& learned
 /// where). Energies are NaN and there is no floor.
 Rollouts follow_measured(const std::vector<Eigen::MatrixXd>& measured, const LearnedField& learned,
                          const RolloutConfig& config);
-
-/// Energy MSE: mean over trajectories and times of (E(true) - E(model))^2, with a standard error
-/// from 5 interleaved splits of the trajectories (the reference's "bootstrap" of 5 splits).
-nn::MeanStderr energy_mse(const Rollouts& rollouts);
-
-/// |E_pred(T) - E_true(T)| / scale at the last time T, mean over the learned rollouts that did
-/// not fail, with the standard error std / sqrt(n): the LNN paper's energy metric (scale 29.4 for
-/// its double pendulum). NaN when all failed.
-nn::MeanStderr energy_error_at_end(const Rollouts& rollouts, double scale);
-
-/// Mean over the learned rollouts that did not fail, their times and every state component of
-/// the squared state error (the dissipative-HNN paper's state MSE), with the standard error of
-/// the per-trajectory means (sample std / sqrt(n)); NaN when all failed.
-nn::MeanStderr state_mse(const Rollouts& rollouts);
-
-/// |x^ - x| / (|x^| + |x|) of each row (time) of a predicted path against the true one.
-Eigen::VectorXd relative_state_error(const Eigen::MatrixXd& pred, const Eigen::MatrixXd& truth);
-
-/// The relative state error e(t) = |x^ - x| / (|x^| + |x|) of the learned rollouts against the
-/// true ones (Finzi et al. 2020): its geometric mean over every trajectory and time after the
-/// start, and the valid prediction time, the first time e passes `threshold` (mean over the
-/// trajectories; a trajectory that never passes it counts its whole span and is `censored`).
-/// Standard errors over trajectories: the valid time's is std / sqrt(n); the geometric mean's
-/// is geomean * (std of the per-trajectory mean log error) / sqrt(n), the delta method's.
-struct RelativeError {
-  double geomean = NAN, geomean_se = NAN, valid_time = NAN, valid_time_se = NAN;
-  int censored = 0, count = 0;
-};
-RelativeError relative_error(const Rollouts& rollouts, double threshold = 0.1);
-
-/// relative_error of the perturbed truth against the truth over the same times: the floor of
-/// Note [Perturbed truth] (its geometric mean), and the valid prediction time of a model whose
-/// only error were that of its start. NaN with count 0 without a floor.
-RelativeError relative_error_floor(const Rollouts& rollouts, double threshold = 0.1);
-
-/// The errors at one of RolloutConfig::horizons, over the learned rollouts that did not fail:
-/// the state MSE (mean over trajectories and components, standard error over trajectories), the
-/// geometric mean of the relative state error and of the floor's (standard errors as above).
-struct HorizonError {
-  double t = NAN;
-  nn::MeanStderr state_mse, relative_error, floor;
-};
-std::vector<HorizonError> horizon_errors(const Rollouts& rollouts);
-
-/// Mean over trajectories of the coordinate MSE at each time (for the charts).
-Eigen::VectorXd coordinate_mse_over_time(const Rollouts& rollouts);
 
 }  // namespace hnn::tasks

@@ -16,7 +16,7 @@
 #include "tasks/experiments/registry.h"
 #include "tasks/field/field_model_run.h"
 #include "tasks/report/json_values.h"
-#include "tasks/train/rollout_objective.h"
+#include "tasks/report/rollout_csv.h"
 
 namespace hnn::tasks {
 
@@ -96,37 +96,9 @@ class DataRun : public FieldModelRun {
  public:
   DataRun(RunSettings settings, Prepared p)
       : FieldModelRun(std::move(settings), p.units.to_model(p.measured.data)), p_(std::move(p)) {
-    const RolloutLossConfig& loss = p_.config.loss;
-    if (!loss.rollout) return;
-    // Checked here, before a run folder exists.
-    train_windows_ = rollout_windows(stretches(p_.measured.train_stretches), loss.horizon);
-    const std::vector<Stretch> test = stretches(p_.measured.held_out);
-    const bool any_test = std::any_of(test.begin(), test.end(),
-                                      [&](const Stretch& t) { return t.x.rows() > loss.horizon; });
-    if (any_test) test_windows_ = rollout_windows(test, loss.horizon);
-    substeps_ = rollout_substeps(train_windows_, loss.dt / p_.units.time);
-    HNN_TASKS_CHECK(s_.train.batch_size <= train_windows_.count(),
-                    "--batch {} is larger than the {} rollout windows of the training set",
-                    s_.train.batch_size, train_windows_.count());
-  }
-
-  // The rollout loss trains from the states alone; the derivative loss as every field task.
-  TrainResult train(const LoopOptions& loop) override {
-    if (!p_.config.loss.rollout) return FieldModelRun::train(loop);
-    return with_scalar(s_.dtype, [&]<typename T>() {
-      std::unique_ptr<nn::DynamicsModel<T>> model = fresh_model<T>();
-      RolloutObjective<T> objective(
-          *model, train_windows_, test_windows_, s_.train.batch_size,
-          {.lr = s_.train.learning_rate, .weight_decay = s_.train.weight_decay}, s_.seed,
-          p_.config.loss.integrator, substeps_);
-      LoopOptions o = loop;
-      o.steps = s_.train.steps;
-      o.lr_schedule = s_.train.lr_schedule;
-      o.record_every = s_.train.record_every;
-      const TrainResult result = tasks::train(objective, o);
-      keep(std::move(model));
-      return result;
-    });
+    const SplitStretches stretches{in_model_units(p_.measured.train_stretches),
+                                   in_model_units(p_.measured.held_out)};
+    training_ = FieldTraining(p_.config.loss, &stretches, s_.train, "data", p_.units.time);
   }
 
   json evaluate(const RunFolder* folder) const override {
@@ -171,23 +143,19 @@ class DataRun : public FieldModelRun {
         physics::linspace(0.0, r.t_end.value_or(rollout_span() * u.time), r.points);
     std::vector<double> t_model(t.size());
     std::transform(t.begin(), t.end(), t_model.begin(), [&](double v) { return v / u.time; });
-    std::string csv = "source,traj,t";
-    for (const std::string& name : p_.measured.state_names) csv += "," + name;
-    csv += ",energy,learned_h\n";
+    PathsCsv csv(p_.measured.state_names, {.times = 12});
     const auto& held = p_.measured.held_out;
     for (std::size_t i = 0; i < held.size() && int(i) < r.trajectories; ++i) {
-      append_rows(csv, "data", i, (held[i].t.array() - held[i].t(0)).matrix(), held[i].x,
-                  std::nullopt);
+      csv.add("data", i, held[i].t.array() - held[i].t(0), held[i].x, energy(held[i].x));
       const Batch z =
           integrator->integrate(model.field, u.to_model(Batch(held[i].x.topRows(1))), t_model)
               .path(0);
-      std::optional<Eigen::VectorXd> h;
-      if (model.hamiltonian) h = model.hamiltonian(z) * u.energy_to_file();
-      append_rows(csv, nn::to_string(s_.model), i,
-                  Eigen::Map<const Eigen::VectorXd>(t.data(), Eigen::Index(t.size())), u.to_file(z),
-                  h);
+      const Batch x = u.to_file(z);
+      csv.add(nn::to_string(s_.model), i, t, x, energy(x),
+              model.hamiltonian ? Eigen::VectorXd(model.hamiltonian(z) * u.energy_to_file())
+                                : Eigen::VectorXd());
     }
-    return csv;
+    return csv.str();
   }
 
   // The units folded into the weights: the first layer takes x instead of z = (x - mean) / scale
@@ -275,30 +243,19 @@ class DataRun : public FieldModelRun {
     return out;
   }
 
-  // Rows source,traj,t,x..,energy (with a known H),learned_h (with h).
-  void append_rows(std::string& csv, std::string_view source, std::size_t traj,
-                   const Eigen::VectorXd& t, const Batch& x,
-                   const std::optional<Eigen::VectorXd>& h) const {
-    const Eigen::VectorXd energy =
-        p_.truth ? p_.truth->energy_batch(x) : Eigen::VectorXd::Constant(x.rows(), NAN);
-    for (Eigen::Index k = 0; k < x.rows(); ++k) {
-      csv += fmt::format("{},{},{:.12g}", source, traj, t(k));
-      for (Eigen::Index c = 0; c < x.cols(); ++c) csv += fmt::format(",{:.12g}", x(k, c));
-      csv += std::isfinite(energy(k)) ? fmt::format(",{:.12g},", energy(k)) : std::string(",,");
-      csv += h ? fmt::format("{:.12g}\n", (*h)(k)) : std::string("\n");
-    }
+  // The known H along x (the energy column), or none.
+  Eigen::VectorXd energy(const Batch& x) const {
+    return p_.truth ? Eigen::VectorXd(p_.truth->energy_batch(x)) : Eigen::VectorXd();
   }
 
   // Stretches in the model's units (time from the file's origin, in the model's unit).
-  std::vector<Stretch> stretches(const std::vector<HeldOut>& parts) const {
+  std::vector<Stretch> in_model_units(const std::vector<HeldOut>& parts) const {
     std::vector<Stretch> out;
     for (const HeldOut& h : parts) out.push_back({h.t / p_.units.time, p_.units.to_model(h.x)});
     return out;
   }
 
   Prepared p_;
-  RolloutWindows train_windows_{}, test_windows_{};
-  int substeps_ = 1;
 };
 
 class DataTask : public Task {

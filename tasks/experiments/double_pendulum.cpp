@@ -11,6 +11,7 @@
 #include <cmath>
 
 #include "tasks/error.h"
+#include "tasks/evaluate/energy_errors.h"
 #include "tasks/experiments/registry.h"
 #include "tasks/field/field_task.h"
 #include "tasks/report/json_values.h"

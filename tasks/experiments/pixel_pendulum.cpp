@@ -66,7 +66,7 @@ class PixelRun : public TaskRun {
     return with_scalar(s_.dtype, [&]<typename T>() {
       auto model = fresh_model<T>();
       pixel::PixelObjective<T> objective(*model, data_, config_, s_.seed);
-      const TrainResult result = tasks::train(objective, loop);
+      const TrainResult result = tasks::train(objective, with_train_config(loop, s_.train));
       keep(std::move(model));
       return result;
     });

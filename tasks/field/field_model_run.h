@@ -1,23 +1,17 @@
 #pragma once
 // The part of a run that every task learning a field dx/dt = f(x) from a Dataset shares: a fresh
-// model from the run's seed, training with FieldObjective, saving and loading. What a task
-// evaluates and rolls out is its own (FieldRun in field_task.cpp, DataRun in
+// model from the run's seed, training as its FieldTraining chooses, saving and loading. What a
+// task evaluates and rolls out is its own (FieldRun in field_task.cpp, DataRun in
 // tasks/experiments/data_task.cpp).
 
 #include "nn/hnn.h"
 #include "nn/parameter_file.h"
 #include "tasks/data/dataset.h"
+#include "tasks/field/field_training.h"
 #include "tasks/task.h"
 #include "tasks/trained_model.h"
 
 namespace hnn::tasks {
-
-/// Trains `model` on `data` with FieldObjective and the training loop: steps, batch size,
-/// learning rate, weight decay and record interval from `config`, the rest (checkpoints, resume,
-/// stop, progress) from `loop`. Minibatches are drawn from a generator seeded with `seed`.
-template <typename T>
-TrainResult train_model(nn::DynamicsModel<T>& model, const Dataset& data, const TrainConfig& config,
-                        std::uint64_t seed, LoopOptions loop = {});
 
 /// How the models see their inputs (angle coordinates, input scales), as the task says.
 struct ModelInput {
@@ -30,7 +24,7 @@ class FieldModelRun : public TaskRun {
   TrainResult train(const LoopOptions& loop) override {
     return with_scalar(s_.dtype, [&]<typename T>() {
       std::unique_ptr<nn::DynamicsModel<T>> model = fresh_model<T>();
-      const TrainResult result = train_model(*model, data_, s_.train, s_.seed, loop);
+      const TrainResult result = training_.train(*model, data_, s_, loop);
       keep(std::move(model));
       return result;
     });
@@ -61,6 +55,7 @@ class FieldModelRun : public TaskRun {
   RunSettings s_;
   Dataset data_;  ///< what the model trains on, in its own units
   ModelInput input_;
+  FieldTraining training_{};  ///< on dx/dt targets unless a run chooses the rollout loss
 
   template <typename T>
   std::unique_ptr<nn::DynamicsModel<T>> fresh_model() const {

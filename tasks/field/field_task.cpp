@@ -10,12 +10,12 @@
 #include <chrono>
 #include <cmath>
 
-#include "autodiff/tape.h"
 #include "physics/integrator.h"
 #include "tasks/evaluate/field_evaluation.h"
+#include "tasks/evaluate/held_out.h"
 #include "tasks/field/field_model_run.h"
-#include "tasks/field/stretch_errors.h"
 #include "tasks/report/json_values.h"
+#include "tasks/report/rollout_csv.h"
 
 namespace hnn::tasks {
 
@@ -23,50 +23,16 @@ namespace {
 
 using nlohmann::json;
 
-// The held-out error along stretches looks at this many test stretches at most.
-constexpr std::size_t kMaxStretches = 200;
-
 class FieldRun : public FieldModelRun {
  public:
   FieldRun(const FieldTask& task, RunSettings settings)
       : FieldModelRun(settings, task.build_dataset(settings),
                       {.angles = task.angle_coordinates(), .input_scale = task.input_scale()}),
-        task_(task),
-        loss_(rollout_loss_config(s_.task_settings, task.name())) {
+        task_(task) {
+    const RolloutLossConfig loss = rollout_loss_config(s_.task_settings, task.name());
     check_rollouts();
     stretches_ = task_.stretches(s_, data_);
-    if (!loss_.rollout) return;
-    // Checked here, before a run folder exists.
-    HNN_TASKS_CHECK(stretches_.has_value(),
-                    "{}: the rollout loss needs trajectories, and this task's data are states "
-                    "without them (use --loss derivative)",
-                    task_.name());
-    train_windows_ = rollout_windows(stretches_->train, loss_.horizon);
-    const bool any_test = std::any_of(stretches_->test.begin(), stretches_->test.end(),
-                                      [&](const Stretch& t) { return t.x.rows() > loss_.horizon; });
-    if (any_test) test_windows_ = rollout_windows(stretches_->test, loss_.horizon);
-    substeps_ = rollout_substeps(train_windows_, loss_.dt);
-    HNN_TASKS_CHECK(s_.train.batch_size <= train_windows_.count(),
-                    "--batch {} is larger than the {} rollout windows of the training set",
-                    s_.train.batch_size, train_windows_.count());
-  }
-
-  TrainResult train(const LoopOptions& loop) override {
-    if (!loss_.rollout) return FieldModelRun::train(loop);
-    return with_scalar(s_.dtype, [&]<typename T>() {
-      std::unique_ptr<nn::DynamicsModel<T>> model = fresh_model<T>();
-      RolloutObjective<T> objective(
-          *model, train_windows_, test_windows_, s_.train.batch_size,
-          {.lr = s_.train.learning_rate, .weight_decay = s_.train.weight_decay}, s_.seed,
-          loss_.integrator, substeps_);
-      LoopOptions o = loop;
-      o.steps = s_.train.steps;
-      o.lr_schedule = s_.train.lr_schedule;
-      o.record_every = s_.train.record_every;
-      const TrainResult result = tasks::train(objective, o);
-      keep(std::move(model));
-      return result;
-    });
+    training_ = FieldTraining(loss, stretches_ ? &*stretches_ : nullptr, s_.train, task_.name());
   }
 
   nlohmann::json evaluate(const RunFolder* folder) const override {
@@ -89,8 +55,13 @@ class FieldRun : public FieldModelRun {
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (folder) folder->write_text("rollout.csv", tasks::rollout_csv(e.rollouts));
     json m = e.metrics;
-    m["training"] = loss_.to_json();
-    if (stretches_ && !stretches_->test.empty()) m.update(held_out_stretches());
+    m["training"] = training_.loss().to_json();
+    if (stretches_ && !stretches_->test.empty()) {
+      m.update(held_out_stretch_metrics(dynamics(), *stretches_,
+                                        {.per_body = task_.coordinates_per_body(),
+                                         .stepping = training_.stepping(),
+                                         .truth = task_.has_truth() ? &task_.truth() : nullptr}));
+    }
     return m;
   }
 
@@ -157,101 +128,18 @@ class FieldRun : public FieldModelRun {
     const std::vector<double> t = physics::linspace(0.0, config.t_end, config.points);
     const std::vector<double> model_t =
         physics::linspace(0.0, r.t_end.value_or(config.t_end), r.points);
-    std::string csv = "source,traj,t";
-    for (Eigen::Index c = 0; c < data_.test_x.cols(); ++c) csv += fmt::format(",x_{}", c);
-    csv += ",energy,learned_h\n";
-    const auto rows = [&](std::string_view source, std::size_t traj, const Eigen::MatrixXd& x,
-                          const std::vector<double>& times) {
-      for (Eigen::Index k = 0; k < x.rows(); ++k) {
-        if (!x.row(k).allFinite()) continue;
-        csv += fmt::format("{},{},{:.9g}", source, traj, times[std::size_t(k)]);
-        for (Eigen::Index c = 0; c < x.cols(); ++c) csv += fmt::format(",{:.12g}", x(k, c));
-        csv += ",,\n";
-      }
-    };
+    PathsCsv csv(numbered_columns("x", data_.test_x.cols()), {}, /*skip_incomplete=*/true);
     const physics::VectorField field = learned_field(dynamics()).field;
     for (std::size_t i = 0; i < paths.size(); ++i) {
-      rows("measured", i, paths[i], t);
-      rows(nn::to_string(s_.model), i,
-           integrator.integrate(field, Batch(paths[i].topRows(1)), model_t).path(0), model_t);
+      csv.add("measured", i, t, paths[i]);
+      csv.add(nn::to_string(s_.model), i, model_t,
+              integrator.integrate(field, Batch(paths[i].topRows(1)), model_t).path(0));
     }
-    return csv;
-  }
-
-  // The model (and the truth by leapfrog, one step per interval) from the first state of each
-  // test stretch along its times. A rollout-trained model steps as it trained (its integrator
-  // and sub-steps: the discrete map it learned); a derivative-trained one is integrated
-  // accurately (dopri5), the best use of a learned field.
-  json held_out_stretches() const {
-    std::vector<Stretch> test(stretches_->test.begin(),
-                              stretches_->test.begin() +
-                                  std::ptrdiff_t(std::min(kMaxStretches, stretches_->test.size())));
-    const int per_body = task_.coordinates_per_body();
-    int failures = 0, train_failures = 0, truth_failures = 0;
-    json m = stretch_errors("stretch_", test, predict_paths(test, model_predictor(), failures),
-                            per_body);
-    m["stretch_failures"] = failures;
-    // The same on training stretches: the gap to the test figure is what generalisation costs.
-    std::vector<Stretch> train(
-        stretches_->train.begin(),
-        stretches_->train.begin() +
-            std::ptrdiff_t(std::min(kMaxStretches, stretches_->train.size())));
-    const json fit = stretch_errors(
-        "train_stretch_", train, predict_paths(train, model_predictor(), train_failures), per_body);
-    m["train_stretch_position_error"] = fit["train_stretch_position_error"];
-    m["train_stretch_state_mse"] = fit["train_stretch_state_mse"];
-    m["train_stretch_failures"] = train_failures;
-    m["stretch_predictor"] = loss_.rollout ? fmt::format("{}, {} step(s) per interval",
-                                                         to_string(loss_.integrator), substeps_)
-                                           : std::string("dopri5 (rtol 1e-9)");
-    m["n_stretches"] = test.size();
-    if (!task_.has_truth()) return m;
-    const Predictor leapfrog = [&](const Batch& x0, const Eigen::VectorXd& t) {
-      const double interval = t.size() > 1 ? t(1) - t(0) : 1.0;
-      const auto integrator = physics::make_integrator("leapfrog", {.dt = interval * (1 + 1e-9)});
-      return integrator->integrate(task_.truth().field(), x0, {t.data(), t.data() + t.size()})
-          .states;
-    };
-    const json truth = stretch_errors("truth_leapfrog_", test,
-                                      predict_paths(test, leapfrog, truth_failures), per_body);
-    m["truth_leapfrog_position_error"] = truth["truth_leapfrog_position_error"];
-    m["truth_leapfrog_position_error_std"] = truth["truth_leapfrog_position_error_std"];
-    m["truth_leapfrog_state_mse"] = truth["truth_leapfrog_state_mse"];
-    m["truth_leapfrog_failures"] = truth_failures;
-    return m;
-  }
-
-  Predictor model_predictor() const {
-    if (!loss_.rollout) {
-      return [this](const Batch& x0, const Eigen::VectorXd& t) {
-        // max_steps as the energy rollouts': a stiff learned field fails here, not hangs.
-        const auto integrator =
-            physics::make_integrator("dopri5", {.rtol = 1e-9, .atol = 1e-12, .max_steps = 100'000});
-        return integrator
-            ->integrate(learned_field(dynamics()).field, x0, {t.data(), t.data() + t.size()})
-            .states;
-      };
-    }
-    return [this](const Batch& x0, const Eigen::VectorXd& t) {
-      ad::TapeScope scope;
-      ad::NoGradGuard values_only;
-      std::vector<Batch> states{x0};
-      ad::Var<double> x = ad::Var<double>::constant(x0);
-      for (Eigen::Index k = 1; k < t.size(); ++k) {
-        const ad::Var<double> h =
-            ad::Var<double>::constant(Batch::Constant(x0.rows(), 1, (t(k) - t(k - 1)) / substeps_));
-        for (int s = 0; s < substeps_; ++s) x = integrator_step(dynamics(), x, h, loss_.integrator);
-        states.push_back(x.value());
-      }
-      return states;
-    };
+    return csv.str();
   }
 
   const FieldTask& task_;
-  RolloutLossConfig loss_;
   std::optional<SplitStretches> stretches_;
-  RolloutWindows train_windows_{}, test_windows_{};
-  int substeps_ = 1;
   int asked_rollouts_ = 0, available_rollouts_ = 0;
 };
 

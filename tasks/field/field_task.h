@@ -18,11 +18,6 @@
 
 namespace hnn::tasks {
 
-/// A dataset's rows as stretches of one trajectory each, split as the dataset is.
-struct SplitStretches {
-  std::vector<Stretch> train, test;
-};
-
 /// Rows in blocks of `points` consecutive states, sampled at linspace(0, t_end, points).
 std::vector<Stretch> regular_stretches(const Batch& x, int points, double t_end);
 

@@ -13,6 +13,7 @@
 #include "tasks/pixel/rollouts.h"
 #include "tasks/report/csv_cell.h"
 #include "tasks/report/json_values.h"
+#include "tasks/report/rollout_csv.h"
 
 namespace hnn::tasks::pixel {
 
@@ -152,35 +153,43 @@ std::string pixel_rollout_csv(const PixelModel<double>& model, const PixelData& 
       physics::make_integrator(o.integrator, {.dt = o.dt, .rtol = o.rtol, .atol = o.rtol * 1e-3});
   // One frame past the last reported: its angle gives the last state's velocity.
   const std::vector<double> t = physics::linspace(0.0, o.frames + 1, o.frames + 2);
+  const Eigen::VectorXd frames = as_vector(t);
   const nn::DynamicsModel<double>& dynamics = model.dynamics();
   const physics::Trajectory path = integrator->integrate(
       [&dynamics](double, const physics::Batch& z, physics::Batch& dz) { dz = dynamics.field(z); },
       z0, t);
-  std::string csv = "source,traj,t,z_q,z_p,theta,p,energy,learned_h\n";
+  PathsCsv csv({"z_q", "z_p", "theta", "p"}, {.values = 9, .times = 9});
   for (int i = 0; i < n; ++i) {
     const std::vector<physics::GymState> states = scene.rollout(
         data.states[std::size_t(data.first_frame(rows[std::size_t(i)]))], o.frames + 2);
+    // The true rows: the angle and momentum, no latent state.
+    Eigen::MatrixXd truth = Eigen::MatrixXd::Constant(o.frames + 1, 4, NAN);
+    Eigen::VectorXd energy(o.frames + 1);
     for (int k = 0; k <= o.frames; ++k) {
       const Eigen::RowVector2d x =
           pair_state(states[std::size_t(k)].th, states[std::size_t(k) + 1].th);
-      csv += fmt::format("true,{},{},,,{:.9g},{:.9g},{:.9g},\n", i, t[std::size_t(k)], x(0), x(1),
-                         scene.energy(x));
+      truth.row(k).tail(2) = x;
+      energy(k) = scene.energy(x);
     }
+    csv.add("true", std::size_t(i), frames.head(o.frames + 1), truth, energy);
     const physics::Batch z = path.path(i);
     const physics::Batch pairs = model.decode(z);
     Eigen::VectorXd h;
     if (model.is_hnn()) h = model.energy(z).col(0);
     // As pixel_rollouts (Note [Velocity from the rollout's frames]): the first frames of
     // consecutive decoded pairs.
+    Eigen::MatrixXd pred(z.rows() - 1, 4);
+    Eigen::VectorXd pred_energy(z.rows() - 1);
     for (Eigen::Index k = 0; k + 1 < z.rows(); ++k) {
       const Eigen::RowVector2d x = state_from_frames(scene, pairs.row(k).head(kFramePixels),
                                                      pairs.row(k + 1).head(kFramePixels));
-      csv += fmt::format("{},{},{},{:.9g},{:.9g},{},{},{},{}\n", model_name, i, t[std::size_t(k)],
-                         z(k, 0), z(k, 1), csv_cell(x(0), 9), csv_cell(x(1), 9),
-                         csv_cell(scene.energy(x), 9), h.size() ? csv_cell(h(k), 9) : "");
+      pred.row(k) << z(k, 0), z(k, 1), x(0), x(1);
+      pred_energy(k) = scene.energy(x);
     }
+    csv.add(model_name, std::size_t(i), frames.head(z.rows() - 1), pred, pred_energy,
+            h.size() ? Eigen::VectorXd(h.head(z.rows() - 1)) : Eigen::VectorXd());
   }
-  return csv;
+  return csv.str();
 }
 
 }  // namespace hnn::tasks::pixel

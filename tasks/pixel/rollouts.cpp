@@ -8,6 +8,7 @@
 
 #include "physics/integrator.h"
 #include "tasks/error.h"
+#include "tasks/evaluate/energy_errors.h"
 #include "tasks/evaluate/rollouts.h"
 
 namespace hnn::tasks::pixel {

@@ -13,16 +13,11 @@
 
 #include "nn/dynamics.h"
 #include "tasks/data/dataset.h"
+#include "tasks/data/stretch.h"
 #include "tasks/train/objective.h"
-#include "tasks/train/rollout_step.h"
+#include "tasks/integrate/integrator_step.h"
 
 namespace hnn::tasks {
-
-/// Stretches of states at their times (rows in time order), in the model's units.
-struct Stretch {
-  Eigen::VectorXd t;
-  Batch x;
-};
 
 /// The windows of horizon + 1 consecutive rows of every stretch: their first states, the
 /// states after each step, and each step's length.

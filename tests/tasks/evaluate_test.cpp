@@ -9,8 +9,11 @@
 
 #include "nn/hnn.h"
 #include "physics/integrator.h"
+#include "tasks/evaluate/energy_errors.h"
 #include "tasks/evaluate/field_evaluation.h"
+#include "tasks/evaluate/loss_stats.h"
 #include "tasks/evaluate/rollouts.h"
+#include "tasks/evaluate/state_errors.h"
 #include "tasks/experiments/registry.h"
 #include "tasks/field/field_task.h"
 #include "tasks/train/field_objective.h"

@@ -24,16 +24,20 @@ const std::map<std::string, std::set<std::string>>& allowed() {
   static const std::map<std::string, std::set<std::string>> layers = {
       {"report", {"report"}},
       {"data", {"data"}},
-      {"train", {"train", "data", "report"}},
-      {"evaluate", {"evaluate", "data", "report"}},
-      {"pixel", {"pixel", "train", "evaluate", "data", "report"}},
-      {"", {"", "train", "evaluate", "data", "report"}},
-      {"field", {"field", "", "train", "evaluate", "data", "report"}},
-      {"experiments", {"experiments", "field", "", "pixel", "train", "evaluate", "data", "report"}},
-      {"run", {"run", "experiments", "field", "", "pixel", "train", "evaluate", "data", "report"}},
+      {"integrate", {"integrate"}},
+      {"train", {"train", "integrate", "data", "report"}},
+      {"evaluate", {"evaluate", "integrate", "data", "report"}},
+      {"pixel", {"pixel", "train", "evaluate", "integrate", "data", "report"}},
+      {"", {"", "train", "evaluate", "integrate", "data", "report"}},
+      {"field", {"field", "", "train", "evaluate", "integrate", "data", "report"}},
+      {"experiments",
+       {"experiments", "field", "", "pixel", "train", "evaluate", "integrate", "data", "report"}},
+      {"run",
+       {"run", "experiments", "field", "", "pixel", "train", "evaluate", "integrate", "data",
+        "report"}},
       {"studies",
-       {"studies", "run", "experiments", "field", "", "pixel", "train", "evaluate", "data",
-        "report"}}};
+       {"studies", "run", "experiments", "field", "", "pixel", "train", "evaluate", "integrate",
+        "data", "report"}}};
   return layers;
 }
 

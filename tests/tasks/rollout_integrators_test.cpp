@@ -1,5 +1,5 @@
-// The rollout loss's integrators on the tape (tasks/train/rollout_step.h): their orders on known
-// systems, energy over long runs, and the implicit midpoint's gradient against finite
+// The rollout loss's integrators on the tape (tasks/integrate/integrator_step.h): their orders on
+// known systems, energy over long runs, and the implicit midpoint's gradient against finite
 // differences of the converged (off-tape) map.
 
 #include <gtest/gtest.h>
@@ -13,7 +13,7 @@
 #include "autodiff/tape.h"
 #include "nn/hnn.h"
 #include "tasks/error.h"
-#include "tasks/train/rollout_step.h"
+#include "tasks/integrate/integrator_step.h"
 
 namespace hnn::tasks {
 namespace {
@@ -94,7 +94,7 @@ TEST(RolloutIntegrators, HaveTheirOrdersOnSeparableSystems) {
 }
 
 // Not separable: the midpoint keeps order 2 and RK4 order 4; the explicit kick-drift-kick drops
-// to order 1 (rollout_step.h), and Yoshida's composition of it with it.
+// to order 1 (tasks/integrate/integrator_step.h), and Yoshida's composition of it with it.
 TEST(RolloutIntegrators, OnANonSeparableFieldLeapfrogIsFirstOrder) {
   const KnownField model = coupled();
   EXPECT_NEAR(measured_order(model, RolloutIntegrator::kMidpoint, 16), 2.0, 0.15);

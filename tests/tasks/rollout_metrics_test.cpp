@@ -9,6 +9,7 @@
 
 #include "tasks/evaluate/field_evaluation.h"
 #include "tasks/evaluate/rollouts.h"
+#include "tasks/evaluate/state_errors.h"
 #include "tasks/experiments/registry.h"
 #include "tasks/field/field_task.h"
 #include "tests/tasks/test_configs.h"

@@ -8,6 +8,8 @@
 
 #include "nn/hnn.h"
 #include "nn/parameter_file.h"
+#include "tasks/evaluate/energy_errors.h"
+#include "tasks/evaluate/loss_stats.h"
 #include "tasks/evaluate/rollouts.h"
 #include "tasks/experiments/registry.h"
 #include "tasks/field/field_model_run.h"

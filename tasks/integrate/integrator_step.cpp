@@ -1,4 +1,4 @@
-#include "tasks/train/rollout_step.h"
+#include "tasks/integrate/integrator_step.h"
 
 #include <cmath>
 #include <limits>

@@ -15,6 +15,10 @@
 //   separable H, symplectic there.
 // - midpoint: the implicit midpoint rule x1 = x0 + h f((x0 + x1)/2), order 2, symplectic for ANY
 //   H, separable or not. Solved off the tape (Note [Midpoint on the tape]).
+//
+// Training steps through them (the rollout loss, tasks/train/rollout_objective.h) and so does
+// evaluation (a rollout-trained model along held-out stretches, tasks/evaluate/held_out.h), so
+// they sit in a folder below both.
 
 #include <string>
 #include <string_view>

@@ -1,0 +1,57 @@
+#include "tasks/field/field_training.h"
+
+#include <algorithm>
+
+#include "tasks/task.h"
+#include "tasks/train/field_objective.h"
+
+namespace hnn::tasks {
+
+template <typename T>
+TrainResult train_model(nn::DynamicsModel<T>& model, const Dataset& data, const TrainConfig& config,
+                        std::uint64_t seed, LoopOptions loop) {
+  FieldObjective<T> objective(model, data, config.batch_size,
+                              {.lr = config.learning_rate, .weight_decay = config.weight_decay},
+                              seed);
+  return train(objective, with_train_config(std::move(loop), config));
+}
+
+template TrainResult train_model(nn::DynamicsModel<float>&, const Dataset&, const TrainConfig&,
+                                 std::uint64_t, LoopOptions);
+template TrainResult train_model(nn::DynamicsModel<double>&, const Dataset&, const TrainConfig&,
+                                 std::uint64_t, LoopOptions);
+
+FieldTraining::FieldTraining(const RolloutLossConfig& loss, const SplitStretches* stretches,
+                             const TrainConfig& train, const std::string& task, double time_unit)
+    : loss_(loss) {
+  if (!loss_.rollout) return;
+  HNN_TASKS_CHECK(stretches != nullptr,
+                  "{}: the rollout loss needs trajectories, and this task's data are states "
+                  "without them (use --loss derivative)",
+                  task);
+  train_windows_ = rollout_windows(stretches->train, loss_.horizon);
+  const bool any_test = std::any_of(stretches->test.begin(), stretches->test.end(),
+                                    [&](const Stretch& t) { return t.x.rows() > loss_.horizon; });
+  if (any_test) test_windows_ = rollout_windows(stretches->test, loss_.horizon);
+  substeps_ = rollout_substeps(train_windows_, loss_.dt / time_unit);
+  HNN_TASKS_CHECK(train.batch_size <= train_windows_.count(),
+                  "--batch {} is larger than the {} rollout windows of the training set",
+                  train.batch_size, train_windows_.count());
+}
+
+template <typename T>
+TrainResult FieldTraining::train(nn::DynamicsModel<T>& model, const Dataset& data,
+                                 const RunSettings& s, const LoopOptions& loop) const {
+  if (!loss_.rollout) return train_model(model, data, s.train, s.seed, loop);
+  RolloutObjective<T> objective(model, train_windows_, test_windows_, s.train.batch_size,
+                                {.lr = s.train.learning_rate, .weight_decay = s.train.weight_decay},
+                                s.seed, loss_.integrator, substeps_);
+  return tasks::train(objective, with_train_config(loop, s.train));
+}
+
+template TrainResult FieldTraining::train(nn::DynamicsModel<float>&, const Dataset&,
+                                          const RunSettings&, const LoopOptions&) const;
+template TrainResult FieldTraining::train(nn::DynamicsModel<double>&, const Dataset&,
+                                          const RunSettings&, const LoopOptions&) const;
+
+}  // namespace hnn::tasks
