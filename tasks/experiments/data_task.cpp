@@ -96,7 +96,7 @@ class DataRun : public FieldModelRun {
  public:
   DataRun(RunSettings settings, Prepared p)
       : FieldModelRun(std::move(settings), p.units.to_model(p.measured.data)), p_(std::move(p)) {
-    const RolloutLossConfig& loss = p_.config.loss;
+    const RolloutLossConfig& loss = s_.loss;
     if (!loss.rollout) return;
     // Checked here, before a run folder exists.
     train_windows_ = rollout_windows(stretches(p_.measured.train_stretches), loss.horizon);
@@ -112,13 +112,13 @@ class DataRun : public FieldModelRun {
 
   // The rollout loss trains from the states alone; the derivative loss as every field task.
   TrainResult train(const LoopOptions& loop) override {
-    if (!p_.config.loss.rollout) return FieldModelRun::train(loop);
+    if (!s_.loss.rollout) return FieldModelRun::train(loop);
     return with_scalar(s_.dtype, [&]<typename T>() {
       std::unique_ptr<nn::DynamicsModel<T>> model = fresh_model<T>();
       RolloutObjective<T> objective(
           *model, train_windows_, test_windows_, s_.train.batch_size,
           {.lr = s_.train.learning_rate, .weight_decay = s_.train.weight_decay}, s_.seed,
-          p_.config.loss.integrator, substeps_);
+          s_.loss.integrator, substeps_);
       LoopOptions o = loop;
       o.steps = s_.train.steps;
       o.lr_schedule = s_.train.lr_schedule;
@@ -152,7 +152,7 @@ class DataRun : public FieldModelRun {
           dynamics(), data_.test_x, [&](const Batch& f) { return p_.units.rate_to_file(f); }));
     }
     m.update(energy_metrics(file));
-    m["training"] = p_.config.loss.to_json();
+    m["training"] = s_.loss.to_json();
     m["units"] = p_.units.to_json();
     m["state_names"] = p_.measured.state_names;
     m["data"] = describe(p_.measured);

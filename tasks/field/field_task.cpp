@@ -32,7 +32,7 @@ class FieldRun : public FieldModelRun {
       : FieldModelRun(settings, task.build_dataset(settings),
                       {.angles = task.angle_coordinates(), .input_scale = task.input_scale()}),
         task_(task),
-        loss_(rollout_loss_config(s_.task_settings, task.name())) {
+        loss_(s_.loss) {
     check_rollouts();
     stretches_ = task_.stretches(s_, data_);
     if (!loss_.rollout) return;
@@ -305,7 +305,6 @@ void FieldTask::check_task_settings(const nlohmann::json& settings) const {
                     "task '{}' has no setting '{}' (known: {})", name(), key,
                     fmt::join(known, ", "));
   }
-  rollout_loss_config(settings, name());
   rollout_config(settings);
 }
 
