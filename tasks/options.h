@@ -13,6 +13,7 @@
 
 #include "nn/dynamics.h"
 #include "tasks/train/loop.h"
+#include "tasks/train/rollout_objective.h"
 
 namespace hnn::tasks {
 
@@ -62,6 +63,10 @@ struct RunSettings {
   TrainConfig train{};
   std::string data_file{};  // measured-data tasks: another file of the same format
   nlohmann::json task_settings = nlohmann::json::object();  // the task's own (Task::open)
+  /// The rollout-loss keys of task_settings ("loss", "horizon", "integrator", "dt"), parsed once
+  /// by resolve() (tasks/run.h): what the field tasks train with. task_settings keeps them as
+  /// given, so that metrics.json and checkpoints record them as before.
+  RolloutLossConfig loss{};
 
   /// The form metrics.json and checkpoints hold ("hidden": "200-200").
   nlohmann::json to_json() const;

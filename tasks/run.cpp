@@ -111,7 +111,8 @@ RunSettings resolve(const Task& task, const RunOptions& o) {
                 .threads = o.threads,
                 .train = train_config(task, o),
                 .data_file = o.data_file,
-                .task_settings = o.task_settings};
+                .task_settings = o.task_settings,
+                .loss = rollout_loss_config(o.task_settings, task.name())};
   check_train_config(s.train);
   return s;
 }

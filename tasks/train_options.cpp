@@ -7,7 +7,7 @@
 #include <limits>
 
 #include "tasks/error.h"
-#include "tasks/train/rollout_step.h"
+#include "tasks/integrate/integrator_step.h"
 
 namespace hnn::tasks {
 

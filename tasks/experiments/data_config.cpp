@@ -58,7 +58,6 @@ DataConfig data_config(const json& s) {
   } catch (const json::exception& e) {
     throw Error(fmt::format("data: bad task settings {}: {}", s.dump(), e.what()));
   }
-  c.loss = rollout_loss_config(s, "data");
   HNN_TASKS_CHECK(c.threshold > 0 && c.threshold < 1,
                   "data: threshold {} is not between 0 and 1 (a relative state error)",
                   c.threshold);

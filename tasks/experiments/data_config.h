@@ -7,7 +7,6 @@
 
 #include "tasks/data/measured_dataset.h"
 #include "tasks/evaluate/rollouts.h"
-#include "tasks/train/rollout_objective.h"
 
 namespace hnn::tasks {
 
@@ -22,7 +21,6 @@ struct DataConfig {
   /// duration). "energy_rollouts" and "energy_t_end" are their older names.
   int rollouts = kDefaultRollouts;
   double t_end = 0;
-  RolloutLossConfig loss{};  ///< dx/dt targets, or through an integrator
 };
 
 /// The names of the data task's settings.

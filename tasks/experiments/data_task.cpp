@@ -98,7 +98,7 @@ class DataRun : public FieldModelRun {
       : FieldModelRun(std::move(settings), p.units.to_model(p.measured.data)), p_(std::move(p)) {
     const SplitStretches stretches{in_model_units(p_.measured.train_stretches),
                                    in_model_units(p_.measured.held_out)};
-    training_ = FieldTraining(p_.config.loss, &stretches, s_.train, "data", p_.units.time);
+    training_ = FieldTraining(s_.loss, &stretches, s_.train, "data", p_.units.time);
   }
 
   json evaluate(const RunFolder* folder) const override {
@@ -124,7 +124,7 @@ class DataRun : public FieldModelRun {
           dynamics(), data_.test_x, [&](const Batch& f) { return p_.units.rate_to_file(f); }));
     }
     m.update(energy_metrics(file));
-    m["training"] = p_.config.loss.to_json();
+    m["training"] = s_.loss.to_json();
     m["units"] = p_.units.to_json();
     m["state_names"] = p_.measured.state_names;
     m["data"] = describe(p_.measured);

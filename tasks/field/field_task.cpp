@@ -29,7 +29,7 @@ class FieldRun : public FieldModelRun {
       : FieldModelRun(settings, task.build_dataset(settings),
                       {.angles = task.angle_coordinates(), .input_scale = task.input_scale()}),
         task_(task) {
-    const RolloutLossConfig loss = rollout_loss_config(s_.task_settings, task.name());
+    const RolloutLossConfig& loss = s_.loss;
     check_rollouts();
     stretches_ = task_.stretches(s_, data_);
     training_ = FieldTraining(loss, stretches_ ? &*stretches_ : nullptr, s_.train, task_.name());
@@ -193,7 +193,6 @@ void FieldTask::check_task_settings(const nlohmann::json& settings) const {
                     "task '{}' has no setting '{}' (known: {})", name(), key,
                     fmt::join(known, ", "));
   }
-  rollout_loss_config(settings, name());
   rollout_config(settings);
 }
 

@@ -32,7 +32,8 @@ struct RolloutWindows {
 RolloutWindows rollout_windows(const std::vector<Stretch>& stretches, int horizon);
 
 /// How a run trains: its task settings "loss" (derivative or rollout), "horizon", "integrator"
-/// and "dt", the same keys on every task that learns a field from states.
+/// and "dt", the same keys on every task that learns a field from states. Parsed once, where a
+/// run's settings are resolved (tasks/run.cpp), into RunSettings::loss.
 struct RolloutLossConfig {
   bool rollout = false;  ///< "loss": "rollout" (else dx/dt targets)
   int horizon = 1;       ///< sampling intervals per window
