@@ -19,10 +19,6 @@ namespace hnn::tasks {
 
 namespace {
 
-// A learned rollout taking more steps than this is reported as failed (with the time reached)
-// rather than left to run for hours: a badly trained field can be stiff enough to need the
-// integrator's default limit of 1e8 steps. True fields keep that default.
-constexpr long kMaxLearnedSteps = 100'000;
 
 Eigen::MatrixXd integrate_one(const physics::VectorField& field, const Eigen::RowVectorXd& x0,
                               const std::vector<double>& t, const RolloutConfig& config, long* nfev,

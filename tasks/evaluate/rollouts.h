@@ -22,6 +22,10 @@ constexpr int kDefaultRollouts = 100;
 constexpr int kMaxRollouts = 1000;
 /// The floor's perturbation: Finzi et al.'s 1e-4 (N(0, 1e-4^2) per component of the start).
 constexpr double kFloorPerturbation = 1e-4;
+/// A learned rollout taking more adaptive steps than this is reported as failed (with the time
+/// reached) rather than left to run for hours: a badly trained field can be stiff enough to need
+/// the integrator's default limit of 1e8 steps. True fields keep that default.
+constexpr long kMaxLearnedSteps = 100'000;
 
 /// How rollouts for the energy metric are made.
 struct RolloutConfig {

@@ -7,13 +7,11 @@
 
 #include "autodiff/tape.h"
 #include "physics/integrator.h"
+#include "tasks/evaluate/rollouts.h"
 
 namespace hnn::tasks {
 
 namespace {
-
-// As the energy rollouts' (tasks/evaluate/rollouts.cpp).
-constexpr long kMaxLearnedSteps = 100'000;
 
 // Whether every stretch has the first one's times after its start.
 bool share_times(const std::vector<Stretch>& stretches, const Eigen::VectorXd& t0) {

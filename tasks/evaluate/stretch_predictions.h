@@ -20,7 +20,7 @@ namespace hnn::tasks {
 using Predictor = std::function<std::vector<Batch>(const Batch& x0, const Eigen::VectorXd& t)>;
 
 /// A field integrated by dopri5 (rtol 1e-9, atol 1e-12) with the learned rollouts' step limit
-/// (tasks/evaluate/rollouts.cpp): a stiff learned field fails here, not hangs. Refers to `field`.
+/// (kMaxLearnedSteps, rollouts.h): a stiff learned field fails here, not hangs.
 Predictor dopri5_predictor(const physics::VectorField& field);
 
 /// How a model steps along held-out stretches: dopri5 on its field, or as it trained (the

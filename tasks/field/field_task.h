@@ -11,10 +11,10 @@
 
 #include "physics/system.h"
 #include "tasks/data/dataset.h"
+#include "tasks/data/stretch.h"
 #include "tasks/data/trajectories.h"
 #include "tasks/evaluate/rollouts.h"
 #include "tasks/task.h"
-#include "tasks/train/rollout_objective.h"
 
 namespace hnn::tasks {
 
