@@ -96,7 +96,7 @@ class DataRun : public FieldModelRun {
  public:
   DataRun(RunSettings settings, Prepared p)
       : FieldModelRun(std::move(settings), p.units.to_model(p.measured.data)), p_(std::move(p)) {
-    if (!p_.config.loss.rollout) return;  // on dx/dt targets: no stretches to convert
+    if (!s_.loss.rollout) return;  // on dx/dt targets: no stretches to convert
     const SplitStretches stretches{in_model_units(p_.measured.train_stretches),
                                    in_model_units(p_.measured.held_out)};
     training_ = FieldTraining(s_.loss, &stretches, s_.train, "data", p_.units.time);
