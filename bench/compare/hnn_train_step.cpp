@@ -26,10 +26,10 @@
 #include "nn/optim.h"
 #include "tasks/experiments/registry.h"
 #include "tasks/field/field_task.h"
+#include "tasks/integrate/integrator_step.h"
 #include "tasks/pixel/model.h"
 #include "tasks/train/field_objective.h"
 #include "tasks/train/rollout_objective.h"
-#include "tasks/integrate/integrator_step.h"
 
 namespace {
 

@@ -19,7 +19,6 @@ namespace hnn::tasks {
 
 namespace {
 
-
 Eigen::MatrixXd integrate_one(const physics::VectorField& field, const Eigen::RowVectorXd& x0,
                               const std::vector<double>& t, const RolloutConfig& config, long* nfev,
                               long max_steps = physics::IntegratorOptions{}.max_steps) {

@@ -14,8 +14,8 @@
 #include "nn/dynamics.h"
 #include "tasks/data/dataset.h"
 #include "tasks/data/stretch.h"
-#include "tasks/train/objective.h"
 #include "tasks/integrate/integrator_step.h"
+#include "tasks/train/objective.h"
 
 namespace hnn::tasks {
 
