@@ -74,7 +74,7 @@ void add_learned(Rollouts& r, const LearnedField& learned, const Eigen::RowVecto
   const Eigen::Index i = Eigen::Index(r.pred.size());
   try {
     const Eigen::MatrixXd path =
-        integrate_one(learned.field, x0, times.all, config, &r.nfev, kMaxLearnedSteps);
+        integrate_one(learned.field, x0, times.all, config, &r.nfev, config.max_learned_steps);
     r.pred.push_back(pick(path, times.grid));
     r.pred_at.push_back(pick(path, times.horizons));
     r.failed.push_back(false);

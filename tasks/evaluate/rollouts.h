@@ -42,6 +42,8 @@ struct RolloutConfig {
   /// Times in (0, t_end] at which the short-horizon errors are reported (chaotic systems, where
   /// errors over the whole span say little); they need not be on the grid of `points`.
   std::vector<double> horizons{};
+  /// The adaptive steps a learned rollout may take before it is recorded as failed.
+  long max_learned_steps = kMaxLearnedSteps;
 };
 
 // Note [Perturbed truth]: how close a perfect model could come. The true system integrated from

@@ -229,8 +229,9 @@ TEST(TrainOptionsTable, EveryRowIsAnOptionOfHnnTrainUnderItsHeadingWithItsDefaul
                      : group.empty()                        ? "Options"
                                                             : group)
         << name;
-    if (!option.default_shown.empty())
+    if (!option.default_shown.empty()) {
       EXPECT_NE(line.find("=" + std::string(option.default_shown)), std::string::npos) << line;
+    }
   }
 }
 
