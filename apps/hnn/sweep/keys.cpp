@@ -24,19 +24,18 @@ using tasks::ValueKind;
 
 namespace {
 
-std::invalid_argument bad(std::string message) { return std::invalid_argument(message); }
-
 std::string one_of(const ordered_json& v, const std::vector<std::string>& names,
                    std::string_view what) {
   if (v.is_string() && std::find(names.begin(), names.end(), v.get<std::string>()) != names.end())
     return v.get<std::string>();
   if (v.is_string())
-    throw bad(fmt::format("unknown {} '{}' (known: {})", what, v.get<std::string>(),
-                          fmt::join(names, ", ")));
-  throw bad(fmt::format("expected a {} ({}), got {}", what, fmt::join(names, ", "), v.dump()));
+    throw std::invalid_argument(fmt::format("unknown {} '{}' (known: {})", what,
+                                            v.get<std::string>(), fmt::join(names, ", ")));
+  throw std::invalid_argument(
+      fmt::format("expected a {} ({}), got {}", what, fmt::join(names, ", "), v.dump()));
 }
 
-long long integer_in(const ordered_json& v, long long min, long long max) {
+long long json_integer_in(const ordered_json& v, long long min, long long max) {
   if (v.is_number_integer()) {
     const bool fits =
         v.is_number_unsigned()
@@ -46,8 +45,9 @@ long long integer_in(const ordered_json& v, long long min, long long max) {
     if (fits) return v.get<long long>();
   }
   if (max == std::numeric_limits<int>::max())
-    throw bad(fmt::format("expected an integer >= {}, got {}", min, v.dump()));
-  throw bad(fmt::format("expected an integer from {} to {}, got {}", min, max, v.dump()));
+    throw std::invalid_argument(fmt::format("expected an integer >= {}, got {}", min, v.dump()));
+  throw std::invalid_argument(
+      fmt::format("expected an integer from {} to {}, got {}", min, max, v.dump()));
 }
 
 std::vector<std::string> columns(const ordered_json& v) {
@@ -63,7 +63,7 @@ std::vector<std::string> columns(const ordered_json& v) {
     }
   }
   if (names.empty() || std::count(names.begin(), names.end(), "") > 0)
-    throw bad(
+    throw std::invalid_argument(
         fmt::format("expected column names, as \"q1,q2\" or [\"q1\", \"q2\"], got {}", v.dump()));
   return names;
 }
@@ -99,36 +99,37 @@ ordered_json checked_value(const TrainOption& key, const ordered_json& v) {
       return one_of(v, key.choices(), key.noun);
     case ValueKind::kSeed:
       if (v.is_number_unsigned()) return v;
-      throw bad(
+      throw std::invalid_argument(
           fmt::format("expected an integer from 0 to 18446744073709551615, got {}", v.dump()));
     case ValueKind::kInt:
-      return integer_in(v, key.min, key.max);
+      return json_integer_in(v, key.min, key.max);
     case ValueKind::kHidden: {
       ordered_json widths = ordered_json::array();
       for (const ordered_json& w : v.is_array() ? v : ordered_json::array({v})) {
         try {
-          widths.push_back(integer_in(w, 1, tasks::kMaxWidth));
+          widths.push_back(json_integer_in(w, 1, tasks::kMaxWidth));
         } catch (const std::invalid_argument&) {
-          throw bad(fmt::format("expected hidden widths of 1..{}, as [200, 200] or 64, got {}",
-                                tasks::kMaxWidth, v.dump()));
+          throw std::invalid_argument(
+              fmt::format("expected hidden widths of 1..{}, as [200, 200] or 64, got {}",
+                          tasks::kMaxWidth, v.dump()));
         }
       }
-      if (widths.empty()) throw bad("expected at least one hidden width, got []");
+      if (widths.empty()) throw std::invalid_argument("expected at least one hidden width, got []");
       return widths;
     }
     case ValueKind::kPositiveReal:
       if (v.is_number() && std::isfinite(v.get<double>()) && v.get<double>() > 0) return v;
-      throw bad(fmt::format("expected a finite number > 0, got {}", v.dump()));
+      throw std::invalid_argument(fmt::format("expected a finite number > 0, got {}", v.dump()));
     case ValueKind::kFraction:
       if (v.is_number() && v.get<double>() > 0 && v.get<double>() < 1) return v;
-      throw bad(fmt::format("expected a number in (0, 1), got {}", v.dump()));
+      throw std::invalid_argument(fmt::format("expected a number in (0, 1), got {}", v.dump()));
     case ValueKind::kFile:
       if (v.is_string() && !v.get<std::string>().empty())
         return fs::absolute(v.get<std::string>()).lexically_normal().string();
-      throw bad(fmt::format("expected a file name, got {}", v.dump()));
+      throw std::invalid_argument(fmt::format("expected a file name, got {}", v.dump()));
     case ValueKind::kJsonObject:
       if (v.is_object()) return v;
-      throw bad(
+      throw std::invalid_argument(
           fmt::format("expected the task's settings as an object, like {{\"trials\": 20}}, "
                       "got {}",
                       v.dump()));
@@ -136,13 +137,13 @@ ordered_json checked_value(const TrainOption& key, const ordered_json& v) {
       return columns(v);
     case ValueKind::kText:
       if (v.is_string() && !v.get<std::string>().empty()) return v;
-      throw bad(fmt::format("expected a non-empty string, got {}", v.dump()));
+      throw std::invalid_argument(fmt::format("expected a non-empty string, got {}", v.dump()));
     case ValueKind::kFolder:
     case ValueKind::kRunFolder:
     case ValueKind::kFlag:
       break;  // out, resume and quiet: the sweep's own (sweep_owned)
   }
-  throw bad(fmt::format("--{} is not a sweep key", key.name));
+  throw std::invalid_argument(fmt::format("--{} is not a sweep key", key.name));
 }
 
 const std::vector<const TrainOption*>& key_table() {
