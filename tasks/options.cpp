@@ -8,6 +8,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "nn/enum_names.h"
 #include "tasks/error.h"
 #include "tasks/report/json_values.h"
 #include "tasks/train_options.h"
@@ -17,6 +18,11 @@ namespace hnn::tasks {
 using nlohmann::json;
 
 namespace {
+
+constexpr nn::NameTable<Dtype, 2> kDtypeNames{
+    {{Dtype::kFloat, "float"}, {Dtype::kDouble, "double"}}};
+constexpr nn::NameTable<Preset, 2> kPresetNames{
+    {{Preset::kPaper, "paper"}, {Preset::kLean, "lean"}}};
 
 // "200-200" (metrics.json's form) or [200, 200] -> {200, 200}; throws Error on anything else.
 std::vector<int> widths_from_json(const json& j) {
@@ -45,22 +51,21 @@ std::vector<int> widths_from_json(const json& j) {
 
 }  // namespace
 
-std::string_view to_string(Dtype dtype) { return dtype == Dtype::kFloat ? "float" : "double"; }
-std::string_view to_string(Preset preset) { return preset == Preset::kLean ? "lean" : "paper"; }
-std::vector<std::string> dtype_names() { return {"float", "double"}; }
-std::vector<std::string> preset_names() { return {"paper", "lean"}; }
-std::vector<std::string> model_names() { return {"hnn", "baseline", "dhnn", "lnn"}; }
+std::string_view to_string(Dtype dtype) { return nn::name_of(kDtypeNames, dtype); }
+std::string_view to_string(Preset preset) { return nn::name_of(kPresetNames, preset); }
+std::vector<std::string> dtype_names() { return nn::names_of(kDtypeNames); }
+std::vector<std::string> preset_names() { return nn::names_of(kPresetNames); }
+std::vector<std::string> model_names() { return nn::names_of(nn::kModelKindNames); }
 
 Dtype parse_dtype(std::string_view name) {
-  if (name == "float") return Dtype::kFloat;
-  if (name == "double") return Dtype::kDouble;
-  throw Error(fmt::format("dtype must be float or double, got '{}'", name));
+  if (const std::optional<Dtype> dtype = nn::find_name(kDtypeNames, name)) return *dtype;
+  throw Error(fmt::format("dtype must be {}, got '{}'", nn::join_names(kDtypeNames, " or "), name));
 }
 
 Preset parse_preset(std::string_view name) {
-  if (name == "paper") return Preset::kPaper;
-  if (name == "lean") return Preset::kLean;
-  throw Error(fmt::format("preset must be paper or lean, got '{}'", name));
+  if (const std::optional<Preset> preset = nn::find_name(kPresetNames, name)) return *preset;
+  throw Error(
+      fmt::format("preset must be {}, got '{}'", nn::join_names(kPresetNames, " or "), name));
 }
 
 nn::ModelKind parse_model(std::string_view name) {
