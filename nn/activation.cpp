@@ -7,11 +7,12 @@
 #include <string>
 
 #include "autodiff/ops.h"
+#include "nn/enum_names.h"
 
 namespace hnn::nn {
 
 namespace {
-constexpr std::array<std::pair<Activation, std::string_view>, 7> kNames{{
+constexpr NameTable<Activation, 7> kActivationNames{{
     {Activation::kTanh, "tanh"},
     {Activation::kRelu, "relu"},
     {Activation::kSigmoid, "sigmoid"},
@@ -22,22 +23,10 @@ constexpr std::array<std::pair<Activation, std::string_view>, 7> kNames{{
 }};
 }  // namespace
 
-std::string_view to_string(Activation activation) {
-  for (const auto& [value, name] : kNames) {
-    if (value == activation) return name;
-  }
-  return "unknown";
-}
+std::string_view to_string(Activation activation) { return name_of(kActivationNames, activation); }
 
 Activation parse_activation(std::string_view name) {
-  std::string valid;
-  for (const auto& [value, known] : kNames) {
-    if (known == name) return value;
-    valid += valid.empty() ? "" : ", ";
-    valid += known;
-  }
-  throw std::invalid_argument(
-      fmt::format("unknown activation '{}' (expected one of: {})", name, valid));
+  return parse_name(kActivationNames, name, "activation");
 }
 
 template <typename T>

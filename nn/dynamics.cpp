@@ -14,47 +14,14 @@
 
 namespace hnn::nn {
 
-namespace {
-
-constexpr std::array<std::pair<ModelKind, std::string_view>, 4> kKindNames{{
-    {ModelKind::kHnn, "hnn"},
-    {ModelKind::kBaseline, "baseline"},
-    {ModelKind::kDhnn, "dhnn"},
-    {ModelKind::kLnn, "lnn"},
-}};
-constexpr std::array<std::pair<FieldType, std::string_view>, 3> kFieldNames{{
-    {FieldType::kSolenoidal, "solenoidal"},
-    {FieldType::kConservative, "conservative"},
-    {FieldType::kBoth, "both"},
-}};
-
-template <typename E, std::size_t N>
-std::string_view name_of(const std::array<std::pair<E, std::string_view>, N>& table, E value) {
-  for (const auto& [v, name] : table) {
-    if (v == value) return name;
-  }
-  return "unknown";
+std::string_view to_string(ModelKind kind) { return name_of(kModelKindNames, kind); }
+std::string_view to_string(FieldType field) { return name_of(kFieldTypeNames, field); }
+ModelKind parse_model_kind(std::string_view name) {
+  return parse_name(kModelKindNames, name, "model");
 }
-
-template <typename E, std::size_t N>
-E parse(const std::array<std::pair<E, std::string_view>, N>& table, const char* what,
-        std::string_view name) {
-  std::string valid;
-  for (const auto& [v, known] : table) {
-    if (known == name) return v;
-    valid += valid.empty() ? "" : ", ";
-    valid += known;
-  }
-  throw std::invalid_argument(
-      fmt::format("unknown {} '{}' (expected one of: {})", what, name, valid));
+FieldType parse_field_type(std::string_view name) {
+  return parse_name(kFieldTypeNames, name, "field type");
 }
-
-}  // namespace
-
-std::string_view to_string(ModelKind kind) { return name_of(kKindNames, kind); }
-std::string_view to_string(FieldType field) { return name_of(kFieldNames, field); }
-ModelKind parse_model_kind(std::string_view name) { return parse(kKindNames, "model", name); }
-FieldType parse_field_type(std::string_view name) { return parse(kFieldNames, "field type", name); }
 
 void validate(const DynamicsConfig& config) {
   if (config.dim < 1) {

@@ -6,6 +6,7 @@
 #include <string_view>
 #include <vector>
 
+#include "nn/enum_names.h"
 #include "nn/mlp.h"
 
 namespace hnn::nn {
@@ -32,7 +33,19 @@ inline bool learns_scalars(ModelKind kind) {
 /// Whether the state's second half is velocities dq/dt (an LNN's), not canonical momenta.
 inline bool needs_velocities(ModelKind kind) { return kind == ModelKind::kLnn; }
 
-/// "hnn", "baseline", "dhnn", "lnn"; "solenoidal", "conservative", "both".
+/// The names: "hnn", "baseline", "dhnn", "lnn"; "solenoidal", "conservative", "both".
+inline constexpr NameTable<ModelKind, 4> kModelKindNames{{
+    {ModelKind::kHnn, "hnn"},
+    {ModelKind::kBaseline, "baseline"},
+    {ModelKind::kDhnn, "dhnn"},
+    {ModelKind::kLnn, "lnn"},
+}};
+inline constexpr NameTable<FieldType, 3> kFieldTypeNames{{
+    {FieldType::kSolenoidal, "solenoidal"},
+    {FieldType::kConservative, "conservative"},
+    {FieldType::kBoth, "both"},
+}};
+
 std::string_view to_string(ModelKind kind);
 std::string_view to_string(FieldType field);
 /// Inverses of to_string; throw std::invalid_argument listing the valid names.

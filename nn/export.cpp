@@ -3,13 +3,20 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <optional>
 #include <stdexcept>
 
+#include "nn/enum_names.h"
 #include "nn/hnn.h"
 
 namespace hnn::nn {
 
 namespace {
+
+constexpr NameTable<ExportFormat, 2> kExportFormatNames{{
+    {ExportFormat::kC, "c"},
+    {ExportFormat::kJson, "json"},
+}};
 
 std::string number(double v) { return fmt::format("{:.17g}", v); }
 
@@ -203,9 +210,11 @@ std::string export_json(const DynamicsModel<double>& model, std::string_view sou
 }  // namespace
 
 ExportFormat parse_export_format(std::string_view name) {
-  if (name == "c") return ExportFormat::kC;
-  if (name == "json") return ExportFormat::kJson;
-  throw std::invalid_argument(fmt::format("unknown export format '{}' (known: c, json)", name));
+  if (const std::optional<ExportFormat> format = find_name(kExportFormatNames, name)) {
+    return *format;
+  }
+  throw std::invalid_argument(
+      fmt::format("unknown export format '{}' (known: {})", name, join_names(kExportFormatNames)));
 }
 
 void check_exportable(const DynamicsModel<double>& model) {

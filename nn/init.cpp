@@ -8,11 +8,13 @@
 #include <numbers>
 #include <stdexcept>
 
+#include "nn/enum_names.h"
+
 namespace hnn::nn {
 
 namespace {
 
-constexpr std::array<std::pair<Init, std::string_view>, 7> kInitNames{{
+constexpr NameTable<Init, 7> kInitNames{{
     {Init::kOrthogonal, "orthogonal"},
     {Init::kXavierUniform, "xavier_uniform"},
     {Init::kXavierNormal, "xavier_normal"},
@@ -75,23 +77,9 @@ Matrix<T> random_uniform(Index rows, Index cols, std::mt19937_64& rng, double lo
   return uniform_matrix(rows, cols, rng, low, high).template cast<T>();
 }
 
-std::string_view to_string(Init init) {
-  for (const auto& [value, name] : kInitNames) {
-    if (value == init) return name;
-  }
-  return "unknown";
-}
+std::string_view to_string(Init init) { return name_of(kInitNames, init); }
 
-Init parse_init(std::string_view name) {
-  std::string valid;
-  for (const auto& [value, known] : kInitNames) {
-    if (known == name) return value;
-    valid += valid.empty() ? "" : ", ";
-    valid += known;
-  }
-  throw std::invalid_argument(
-      fmt::format("unknown initialisation '{}' (expected one of: {})", name, valid));
-}
+Init parse_init(std::string_view name) { return parse_name(kInitNames, name, "initialisation"); }
 
 template <typename T>
 Matrix<T> orthogonal(Index rows, Index cols, std::mt19937_64& rng, double gain) {

@@ -6,6 +6,7 @@
 #include <set>
 
 #include "nn/atomic_file.h"
+#include "nn/enum_names.h"
 #include "nn/parameter_file_format.h"
 
 namespace hnn::nn {
@@ -17,9 +18,14 @@ ParameterFileError::ParameterFileError(const fs::path& path, const std::string& 
       path_(path),
       reason_(reason) {}
 
-std::string_view to_string(ScalarType type) {
-  return type == ScalarType::kFloat32 ? "float32" : "float64";
-}
+namespace {
+constexpr NameTable<ScalarType, 2> kScalarTypeNames{{
+    {ScalarType::kFloat32, "float32"},
+    {ScalarType::kFloat64, "float64"},
+}};
+}  // namespace
+
+std::string_view to_string(ScalarType type) { return name_of(kScalarTypeNames, type); }
 
 template <typename T>
 void save_parameters(const fs::path& path, std::string_view kind,

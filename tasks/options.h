@@ -97,7 +97,8 @@ struct RunOptions {
 };
 
 /// The options that rebuild a run from RunSettings::to_json (metrics.json or a checkpoint's
-/// settings): every setting as an override. Throws Error naming `where` and the bad key.
+/// settings): every setting as an override. Throws Error naming `where` and the bad key. Made,
+/// with RunSettings::to_json, from the table of train_options.h (train_options_json.cpp).
 RunOptions options_from_json(const nlohmann::json& settings, const std::string& where);
 
 /// "200-200".

@@ -6,6 +6,8 @@
 
 #include <limits>
 
+#include "nn/enum_names.h"
+#include "tasks/data/measured_dataset.h"
 #include "tasks/error.h"
 #include "tasks/integrate/integrator_step.h"
 
@@ -20,7 +22,7 @@ constexpr std::string_view kDataGroup = "The data task (hnn train data --data FI
 constexpr std::string_view kRolloutGroup =
     "Training through an integrator (every task that learns a field)";
 
-std::vector<std::string> split_names() { return {"auto", "trajectories", "time"}; }
+std::vector<std::string> split_names() { return nn::names_of(kSplitByNames); }
 
 // In --help's order. A sweep key's rank is its place in run folder names (spring/hnn/seed=1,
 // steps=200): fixed, so that sweeps written before keep their folders.
@@ -270,7 +272,7 @@ const TrainOption* find_train_option(std::string_view name) {
 }
 
 std::vector<std::string> loss_names() { return {"derivative", "rollout"}; }
-std::vector<std::string> lr_schedule_names() { return {"constant", "cosine"}; }
+std::vector<std::string> lr_schedule_names() { return nn::names_of(kLrScheduleNames); }
 
 std::string not_applicable(const TrainOption& option, const std::string& task) {
   if (option.applies_to != AppliesTo::kDataTask || task == "data") return "";

@@ -4,7 +4,8 @@
 // key of `hnn sweep`'s spec (or why the sweep sets it itself), which tasks it applies to, and
 // where its value lands: a RunOptions field or a key of the task's settings. From it are made
 // the command line and the resume guard (apps/hnn/commands/train.cpp), the sweep keys
-// (apps/hnn/sweep/keys.cpp) and the JSON form of metrics.json and checkpoints (options.cpp).
+// (apps/hnn/sweep/keys.cpp) and the JSON form of metrics.json and checkpoints
+// (train_options_json.cpp).
 // Every front end turns what it reads into one canonical JSON value per option and hands it to
 // apply(), the one place an option reaches RunOptions.
 

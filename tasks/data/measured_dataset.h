@@ -3,7 +3,10 @@
 // on, plus what evaluating without a known H needs (each held-out stretch's own times and
 // states, to roll out from its first state and compare).
 
+#include <array>
 #include <string>
+#include <string_view>
+#include <utility>
 #include <vector>
 
 #include "tasks/data/dataset.h"
@@ -16,6 +19,13 @@ enum class SplitBy {
   kTrajectories,  ///< the last trajectories (in order of first appearance) are the test set
   kTime,          ///< the last rows of every trajectory are the test set
 };
+/// SplitBy's names, read both ways through nn/enum_names.h by the layers above (which link nn/;
+/// this one does not, so the table is spelled as the nn::NameTable it is).
+inline constexpr std::array<std::pair<SplitBy, std::string_view>, 3> kSplitByNames{{
+    {SplitBy::kAuto, "auto"},
+    {SplitBy::kTrajectories, "trajectories"},
+    {SplitBy::kTime, "time"},
+}};
 
 struct SplitChoice {
   SplitBy by = SplitBy::kAuto;

@@ -4,6 +4,9 @@
 
 #include <fmt/format.h>
 
+#include <optional>
+
+#include "nn/enum_names.h"
 #include "tasks/error.h"
 #include "tasks/field/rollout_settings.h"
 
@@ -22,10 +25,9 @@ std::vector<std::string> columns(const json& j) {
 }
 
 SplitBy parse_split(const std::string& name) {
-  if (name == "auto") return SplitBy::kAuto;
-  if (name == "trajectories") return SplitBy::kTrajectories;
-  if (name == "time") return SplitBy::kTime;
-  throw Error(fmt::format("data: split '{}' is not one of auto, trajectories, time", name));
+  if (const std::optional<SplitBy> split = nn::find_name(kSplitByNames, name)) return *split;
+  throw Error(
+      fmt::format("data: split '{}' is not one of {}", name, nn::join_names(kSplitByNames)));
 }
 
 }  // namespace

@@ -2,17 +2,27 @@
 
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <type_traits>
 
 #include "autodiff/functional.h"
 #include "autodiff/grad.h"
 #include "autodiff/ops.h"
 #include "autodiff/tape.h"
+#include "nn/enum_names.h"
 #include "tasks/error.h"
 
 namespace hnn::tasks {
 
 namespace {
+
+// In --help's order (tasks/train_options.cpp lists them).
+constexpr nn::NameTable<RolloutIntegrator, 4> kIntegratorNames{{
+    {RolloutIntegrator::kLeapfrog, "leapfrog"},
+    {RolloutIntegrator::kYoshida4, "yoshida4"},
+    {RolloutIntegrator::kMidpoint, "midpoint"},
+    {RolloutIntegrator::kRk4, "rk4"},
+}};
 
 thread_local long t_midpoint_iterations = 0;
 
@@ -139,30 +149,15 @@ Var<T> midpoint(const nn::DynamicsModel<T>& model, const Var<T>& x, const Var<T>
 }  // namespace
 
 std::string_view to_string(RolloutIntegrator integrator) {
-  switch (integrator) {
-    case RolloutIntegrator::kRk4:
-      return "rk4";
-    case RolloutIntegrator::kLeapfrog:
-      return "leapfrog";
-    case RolloutIntegrator::kYoshida4:
-      return "yoshida4";
-    case RolloutIntegrator::kMidpoint:
-      return "midpoint";
-  }
-  return "?";
+  return nn::name_of(kIntegratorNames, integrator);
 }
 
-std::vector<std::string> rollout_integrator_names() {
-  return {"leapfrog", "yoshida4", "midpoint", "rk4"};
-}
+std::vector<std::string> rollout_integrator_names() { return nn::names_of(kIntegratorNames); }
 
 RolloutIntegrator parse_rollout_integrator(std::string_view name) {
-  for (RolloutIntegrator i : {RolloutIntegrator::kRk4, RolloutIntegrator::kLeapfrog,
-                              RolloutIntegrator::kYoshida4, RolloutIntegrator::kMidpoint}) {
-    if (to_string(i) == name) return i;
-  }
-  throw Error(fmt::format(
-      "the rollout loss's integrator '{}' is not one of leapfrog, yoshida4, midpoint, rk4", name));
+  if (const std::optional<RolloutIntegrator> i = nn::find_name(kIntegratorNames, name)) return *i;
+  throw Error(fmt::format("the rollout loss's integrator '{}' is not one of {}", name,
+                          nn::join_names(kIntegratorNames)));
 }
 
 long midpoint_iterations() { return t_midpoint_iterations; }

@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cmath>
 #include <numbers>
+#include <optional>
 #include <stdexcept>
 
 #include "autodiff/grad.h"
@@ -180,15 +181,14 @@ class Loop {
 
 }  // namespace
 
-std::string_view to_string(LrSchedule schedule) {
-  return schedule == LrSchedule::kCosine ? "cosine" : "constant";
-}
+std::string_view to_string(LrSchedule schedule) { return nn::name_of(kLrScheduleNames, schedule); }
 
 LrSchedule parse_lr_schedule(std::string_view name) {
-  if (name == "constant") return LrSchedule::kConstant;
-  if (name == "cosine") return LrSchedule::kCosine;
-  throw std::invalid_argument(
-      fmt::format("unknown learning-rate schedule '{}' (expected constant or cosine)", name));
+  if (const std::optional<LrSchedule> schedule = nn::find_name(kLrScheduleNames, name)) {
+    return *schedule;
+  }
+  throw std::invalid_argument(fmt::format("unknown learning-rate schedule '{}' (expected {})", name,
+                                          nn::join_names(kLrScheduleNames, " or ")));
 }
 
 double lr_factor(LrSchedule schedule, long step, long steps) {

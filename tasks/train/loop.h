@@ -10,6 +10,7 @@
 #include <string_view>
 #include <vector>
 
+#include "nn/enum_names.h"
 #include "tasks/report/run_folder.h"
 #include "tasks/train/objective.h"
 #include "tasks/train/stop.h"
@@ -25,6 +26,10 @@ struct TrainResult {
 /// How the learning rate moves over a run: constant, or cosine decay from the set rate at step
 /// 1 towards 0 after the last step (Loshchilov & Hutter 2017, without restarts).
 enum class LrSchedule { kConstant, kCosine };
+inline constexpr nn::NameTable<LrSchedule, 2> kLrScheduleNames{{
+    {LrSchedule::kConstant, "constant"},
+    {LrSchedule::kCosine, "cosine"},
+}};
 std::string_view to_string(LrSchedule schedule);
 /// Inverse of to_string; throws std::invalid_argument naming the valid values.
 LrSchedule parse_lr_schedule(std::string_view name);
