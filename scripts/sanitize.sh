@@ -3,7 +3,9 @@
 # built in its own folder (build-asan) so that it never disturbs build/. -O2 keeps the suite fast
 # (Eigen is inlined and vectorised; -O1 made training ~50x slower than Release); -g1 gives the
 # reports file:line; asserts stay on (no NDEBUG). The libraries train at -O2 while the test files,
-# which mostly set up and assert, build at -O1 (tests/CMakeLists.txt).
+# which mostly set up and assert, build at -O1 (tests/CMakeLists.txt). UBSan leaves out its pointer
+# checks, half of the build's time (CMakeLists.txt says why), and each test program runs whole in
+# four shards, <module>.shard0..3 (tests/CMakeLists.txt).
 # Any finding fails the test that triggers it. Safe to re-run; extra arguments go to ctest
 # (e.g. -R reliability). HNN_JOBS sets the parallelism (default: the CPU count).
 set -euo pipefail
