@@ -62,6 +62,12 @@ struct RunSettings {
   int threads = 2;  // the engine's threads: fused kernels split each batch into row blocks
   TrainConfig train{};
   std::string data_file{};  // measured-data tasks: another file of the same format
+  /// The data file's SHA-256 (data/file_digest.h), set by run_training with the file's absolute
+  /// path: a run finds its data after a move and refuses another file (tasks/run.h load_run).
+  std::string data_sha256{};
+  /// The --steps of the run before each time it was continued (`hnn train --resume RUN --steps
+  /// N`), oldest first; empty for a run trained in one go.
+  std::vector<int> continued_from{};
   nlohmann::json task_settings = nlohmann::json::object();  // the task's own (Task::open)
   /// The rollout-loss keys of task_settings ("loss", "horizon", "integrator", "dt"), parsed once
   /// by resolve() (tasks/run.h): what the field tasks train with. task_settings keeps them as
@@ -84,14 +90,20 @@ struct RunOptions {
   std::optional<double> learning_rate{}, weight_decay{};
   std::optional<LrSchedule> lr_schedule{};
   std::string data_file{};
+  std::string data_sha256{};  // a recorded run's (RunSettings::data_sha256)
+  std::vector<int> continued_from{};
   nlohmann::json task_settings = nlohmann::json::object();
   std::filesystem::path out{};
+  /// Replace the run already in `out`: its files are removed once the new run's data are read.
+  bool force = false;
   bool quiet = false;
   /// Checkpoints into out/checkpoint every this many steps (default: a tenth of the steps), at
   /// the end, and when stopped.
   std::optional<long> checkpoint_every{};
   /// Continue the run in `out` from its last checkpoint (see resume_options).
   bool resume = false;
+  /// With resume: the finished run of continued_from.back() steps goes on to `steps`.
+  bool continuing = false;
   /// Polled by the training loop (e.g. set on SIGINT): checkpoint and stop after the step.
   StopSignal* stop = nullptr;
 };

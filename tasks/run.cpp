@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "autodiff/parallel.h"
+#include "tasks/data/file_digest.h"
 #include "tasks/experiments/registry.h"
 #include "tasks/report/json_values.h"
 #include "tasks/train/checkpoint.h"
@@ -68,8 +69,58 @@ LoopOptions loop_options(const RunOptions& o, const RunSettings& s, const RunFol
           .checkpoint_dir = folder.checkpoint_dir(),
           .checkpoint_every = o.checkpoint_every.value_or(0),
           .resume = o.resume,
+          .checkpoint_steps = o.continuing ? o.continued_from.back() : 0,
           .run_settings = s.to_json(),
           .stop = o.stop};
+}
+
+// The run's data file where the settings name it, before it is read: one line when it is
+// missing, or (a recorded SHA-256) when it is another file than the run's.
+void check_own_data(const RunSettings& s, const fs::path& run_dir) {
+  if (s.data_file.empty()) return;
+  std::error_code ec;
+  HNN_TASKS_CHECK(fs::is_regular_file(s.data_file, ec),
+                  "the data file '{}' of run '{}' is missing (moved?): give its place with "
+                  "--data FILE",
+                  s.data_file, run_dir.string());
+  if (s.data_sha256.empty()) return;  // a run from before the checksum
+  const std::string sha = file_sha256(s.data_file);
+  HNN_TASKS_CHECK(sha == s.data_sha256,
+                  "'{}' is not the data file of run '{}' (its SHA-256 is {}..., the run's {}...): "
+                  "give the run's own file with --data FILE",
+                  s.data_file, run_dir.string(), sha.substr(0, 12), s.data_sha256.substr(0, 12));
+}
+
+// The data file as a run records it: by absolute path, and its SHA-256 (kept when recorded).
+void record_data_file(RunSettings& s) {
+  if (s.data_file.empty()) return;
+  s.data_file = fs::absolute(s.data_file).lexically_normal().string();
+  if (s.data_sha256.empty()) s.data_sha256 = file_sha256(s.data_file);
+}
+
+bool holds_run(const RunFolder& folder) {
+  std::error_code ec;
+  return fs::exists(folder.file("metrics.json"), ec) || fs::exists(folder.params_file(), ec) ||
+         fs::exists(folder.checkpoint_dir() / "state.json", ec);
+}
+
+// Whether `dir` holds nothing but a checkpoint/ folder without state.json: what a run killed
+// before its first checkpoint committed leaves, nothing to keep (Note [Checkpoint commit] in
+// tasks/train/checkpoint.h: the next checkpoint removes it).
+bool only_uncommitted_checkpoint(const RunFolder& folder) {
+  for (const fs::directory_entry& entry : fs::directory_iterator(folder.path()))
+    if (entry.path().filename() != folder.checkpoint_dir().filename()) return false;
+  return !fs::exists(folder.checkpoint_dir() / "state.json");
+}
+
+// "'a.txt', 'b'" (the first few entries of a folder), for a message.
+std::string some_entries(const fs::path& dir) {
+  std::vector<std::string> names;
+  for (const fs::directory_entry& entry : fs::directory_iterator(dir)) {
+    names.push_back("'" + entry.path().filename().string() + "'");
+    if (names.size() == 3) break;
+  }
+  return fmt::format("{}", fmt::join(names, ", "));
 }
 
 // The metrics of a trained run, with its settings: metrics.json's content.
@@ -111,6 +162,8 @@ RunSettings resolve(const Task& task, const RunOptions& o) {
                 .threads = o.threads,
                 .train = train_config(task, o),
                 .data_file = o.data_file,
+                .data_sha256 = o.data_sha256,
+                .continued_from = o.continued_from,
                 .task_settings = o.task_settings,
                 .loss = rollout_loss_config(o.task_settings, task.name())};
   check_train_config(s.train);
@@ -128,14 +181,25 @@ RunSettings validate(const RunOptions& o) {
 }
 
 json run_training(const RunOptions& o) {
-  const RunSettings settings = validate(o);
+  RunSettings settings = validate(o);
+  if (o.resume) {
+    check_own_data(settings, o.out);
+  } else {
+    check_new_run_folder(o.out, o.force);
+  }
   ad::set_num_threads(settings.threads);  // the fused kernels' row blocks
   const std::unique_ptr<Task> task = make_task(settings.task);
   const auto start = std::chrono::steady_clock::now();
   const std::unique_ptr<TaskRun> run = task->open(settings);
   const double data_seconds = seconds_since(start);
+  record_data_file(settings);
   const RunFolder folder(o.out);
-  folder.create();  // after the data: bad data leave no folder behind
+  // After the data: bad data leave the folder as it was, or no folder.
+  if (o.force && !o.resume && fs::is_directory(o.out)) {
+    for (const fs::directory_entry& entry : fs::directory_iterator(o.out))
+      fs::remove_all(entry.path());
+  }
+  folder.create();
   const TrainResult trained = run->train(loop_options(o, settings, folder));
   run->save(folder.params_file());
   folder.write_loss_curve(trained.curve);
@@ -145,14 +209,23 @@ json run_training(const RunOptions& o) {
   return metrics;
 }
 
-LoadedRun load_run(const fs::path& run_dir, const std::string& data_file) {
+fs::path default_run_folder(const RunOptions& o) {
+  fs::path dir = fs::path("runs") / o.task;
+  if (!o.data_file.empty()) dir /= fs::path(o.data_file).stem();
+  return dir / nn::to_string(o.model);
+}
+
+LoadedRun load_run(const fs::path& run_dir, const std::string& data_file, DataFileUse use) {
   const RunFolder folder(run_dir);
   RunOptions options =
       options_from_json(folder.read_metrics(), "'" + folder.file("metrics.json").string() + "'");
   if (!data_file.empty()) options.data_file = data_file;
+  if (use == DataFileUse::kOther) options.data_sha256.clear();  // recorded: the other file's
   LoadedRun loaded;
   loaded.task = make_task(options.task);
   loaded.settings = resolve(*loaded.task, options);
+  check_own_data(loaded.settings, run_dir);
+  record_data_file(loaded.settings);
   ad::set_num_threads(loaded.settings.threads);
   loaded.run = loaded.task->open(loaded.settings);
   loaded.run->load(folder.params_file());
@@ -160,7 +233,8 @@ LoadedRun load_run(const fs::path& run_dir, const std::string& data_file) {
 }
 
 json evaluate_run(const fs::path& run_dir, const std::string& data_file, bool write_files) {
-  const LoadedRun loaded = load_run(run_dir, data_file);
+  const LoadedRun loaded =
+      load_run(run_dir, data_file, data_file.empty() ? DataFileUse::kRunsOwn : DataFileUse::kOther);
   const RunFolder folder(run_dir);
   json metrics = loaded.run->evaluate(write_files ? &folder : nullptr);
   metrics.update(loaded.settings.to_json());
@@ -190,12 +264,32 @@ json reversibility(const fs::path& run_dir, const ReversibilityOptions& options)
   return result;
 }
 
-RunOptions resume_options(const fs::path& run_dir) {
+RunOptions resume_options(const fs::path& run_dir, std::optional<int> steps) {
   const fs::path dir = RunFolder(run_dir).checkpoint_dir();
-  RunOptions o = options_from_json(read_train_state(dir).run,
-                                   fmt::format("the checkpoint in '{}'", dir.string()));
+  const TrainState state = read_train_state(dir);
+  RunOptions o = options_from_json(state.run, fmt::format("the checkpoint in '{}'", dir.string()));
   o.out = run_dir;
   o.resume = true;
+  if (!steps || *steps == state.total_steps) return o;
+  const std::string run = run_dir.string();
+  HNN_TASKS_CHECK(state.step >= state.total_steps,
+                  "'{}' holds an unfinished run (step {} of {}): --steps continues a finished run; "
+                  "finish this one first with `hnn train --resume {}`",
+                  run, state.step, state.total_steps, run);
+  HNN_TASKS_CHECK(*steps > state.total_steps,
+                  "--steps {} is fewer than the {} steps run '{}' was trained for: --resume with "
+                  "--steps continues a run to more steps",
+                  *steps, state.total_steps, run);
+  // A cosine schedule is a function of the step and the total: continued, the rate would jump
+  // back up from ~0, unlike any run of `steps` from the start.
+  HNN_TASKS_CHECK(o.lr_schedule != LrSchedule::kCosine,
+                  "run '{}' decayed its learning rate to 0 over its {} steps (--lr-schedule "
+                  "cosine): continuing it would start the decay again; train a new run with "
+                  "--steps {}",
+                  run, state.total_steps, *steps);
+  o.continued_from.push_back(int(state.total_steps));
+  o.steps = *steps;
+  o.continuing = true;
   return o;
 }
 
@@ -205,8 +299,26 @@ void check_no_unfinished_run(const fs::path& run_dir) {
   const TrainState state = read_train_state(dir);
   HNN_TASKS_CHECK(state.step >= state.total_steps,
                   "'{}' holds an unfinished run (step {} of {}): continue it with `hnn train "
-                  "--resume {}`, or choose another --out, or delete '{}'",
-                  run_dir.string(), state.step, state.total_steps, run_dir.string(), dir.string());
+                  "--resume {}`, or replace it with --force, or choose another --out",
+                  run_dir.string(), state.step, state.total_steps, run_dir.string());
+}
+
+void check_new_run_folder(const fs::path& out, bool force) {
+  std::error_code ec;
+  if (!fs::is_directory(out, ec) || fs::is_empty(out, ec)) return;  // validate refuses a file
+  const RunFolder folder(out);
+  if (only_uncommitted_checkpoint(folder)) return;
+  const std::string dir = out.string();
+  if (!holds_run(folder)) {
+    throw Error(fmt::format("'{}' is not empty and holds no run ({}){}: choose another --out", dir,
+                            some_entries(out), force ? ", so --force does not clear it" : ""));
+  }
+  if (force) return;
+  check_no_unfinished_run(out);
+  throw Error(
+      fmt::format("'{}' already holds a run: replace it with --force (its files are "
+                  "removed), or choose another --out",
+                  dir));
 }
 
 }  // namespace hnn::tasks

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 
 #include "tasks/evaluate/reversibility.h"
@@ -23,7 +24,14 @@ RunSettings validate(const RunOptions& options);
 
 /// Trains and evaluates one model; writes the run folder `options.out` and returns metrics.json's
 /// content. Throws on bad options or data (nothing half-written is left: each file is atomic).
+/// A fresh run refuses a folder that is not empty (check_new_run_folder); with options.force
+/// the run it holds is removed, file by file, once the new run's data are read. The data file
+/// is recorded by its absolute path and SHA-256 (RunSettings::data_sha256).
 nlohmann::json run_training(const RunOptions& options);
+
+/// `hnn train`'s folder without --out: runs/TASK/MODEL, or runs/TASK/STEM/MODEL for a data file
+/// STEM.EXT, so that the runs of two files do not share a folder.
+std::filesystem::path default_run_folder(const RunOptions& options);
 
 /// A finished run loaded back: its settings, its task and the run (data and trained model).
 struct LoadedRun {
@@ -32,12 +40,24 @@ struct LoadedRun {
   std::unique_ptr<TaskRun> run;  // refers to `task`: declared after it, destroyed before it
 };
 
-/// Reads run_dir/metrics.json and run_dir/params.bin (rebuilding the task's data from its seed);
-/// `data_file` replaces the run's own (measured-data tasks).
-LoadedRun load_run(const std::filesystem::path& run_dir, const std::string& data_file = "");
+/// Which data a run is loaded with (measured-data tasks).
+enum class DataFileUse {
+  /// The run's own: at the recorded absolute path, or at `data_file` when it has moved; a file
+  /// whose SHA-256 is not the recorded one is refused (runs from before the checksum: any).
+  kRunsOwn,
+  /// `data_file`, another file of the same format (`hnn evaluate --data`).
+  kOther,
+};
 
-/// The metrics of the parameters saved in a run folder, again (same task, seed and data); with
-/// write_files, the evaluation's files are written again too.
+/// Reads run_dir/metrics.json and run_dir/params.bin (rebuilding the task's data from its seed
+/// or its data file, as `use` says). Throws Error with one line when the data file is missing
+/// or not the run's.
+LoadedRun load_run(const std::filesystem::path& run_dir, const std::string& data_file = "",
+                   DataFileUse use = DataFileUse::kRunsOwn);
+
+/// The metrics of the parameters saved in a run folder, again (same task and seed; the run's own
+/// data, or `data_file`, another file); with write_files, the evaluation's files are written
+/// again too.
 nlohmann::json evaluate_run(const std::filesystem::path& run_dir, const std::string& data_file,
                             bool write_files);
 
@@ -53,11 +73,19 @@ nlohmann::json reversibility(const std::filesystem::path& run_dir,
                              const ReversibilityOptions& options = {});
 
 /// The options of the run in `run_dir`, read from its last checkpoint, with resume set: passed
-/// to run_training, it continues that run and ends as the uninterrupted run would have.
-RunOptions resume_options(const std::filesystem::path& run_dir);
+/// to run_training, it continues that run and ends as the uninterrupted run would have. With
+/// `steps` more than a finished run's, it goes on to that many (recorded in continued_from),
+/// and ends as a run trained for `steps` from the start would have; refused for an unfinished
+/// run, fewer steps, or a cosine schedule (which would start again from the decayed rate).
+RunOptions resume_options(const std::filesystem::path& run_dir,
+                          std::optional<int> steps = std::nullopt);
 
 /// Throws Error when `run_dir` holds an unfinished run (interrupted, killed or diverged), whose
 /// checkpoint a fresh run would replace: the message says how to resume it instead.
 void check_no_unfinished_run(const std::filesystem::path& run_dir);
+
+/// Throws Error unless `out` may take a fresh run: missing, empty, or (with force) holding a
+/// run, finished or not. A folder holding other files is refused even with force.
+void check_new_run_folder(const std::filesystem::path& out, bool force);
 
 }  // namespace hnn::tasks

@@ -45,7 +45,9 @@ const TrainOption kOptions[] = {
      .noun = "model"},
     {.name = "steps",
      .kind = ValueKind::kInt,
-     .help = "Training steps (default: the paper's)",
+     .help = "Training steps (default: the paper's); with --resume, more than a finished "
+             "run's: continue it to this many",
+     .continues_resume = true,
      .sweep_rank = 6,
      .lands = Lands::kSteps,
      .key = "steps",
@@ -120,16 +122,24 @@ const TrainOption kOptions[] = {
      .noun = "learning-rate schedule"},
     {.name = "data",
      .kind = ValueKind::kFile,
-     .help = "The data task's file, or real-pendulum's measured data in its format",
+     .help = "The data task's file, or real-pendulum's measured data in its format; with "
+             "--resume, the run's own file at a new place (another file is refused)",
+     .with_resume = true,
      .sweep_rank = 10,
      .lands = Lands::kDataFile,
      .key = "data_file",
      .recorded_default = R"("")"},
     {.name = "out",
      .kind = ValueKind::kFolder,
-     .help = "Run folder (default runs/TASK/MODEL)",
+     .help = "Run folder (default runs/TASK/MODEL, or runs/TASK/STEM/MODEL with --data STEM.EXT)",
      .sweep_owned = "set by hnn sweep (OUT/runs/<run>)",
      .lands = Lands::kOut},
+    {.name = "force",
+     .kind = ValueKind::kFlag,
+     .help = "Replace the run already in the --out folder (all its files are removed once the "
+             "new run's data are read); without it a folder that is not empty is refused",
+     .sweep_owned = "hnn sweep trains each run into a folder of its own that holds no run",
+     .lands = Lands::kForce},
     {.name = "quiet",
      .kind = ValueKind::kFlag,
      .help = "No progress output",
@@ -154,7 +164,8 @@ const TrainOption kOptions[] = {
      .max = kIntMax},
     {.name = "resume",
      .kind = ValueKind::kRunFolder,
-     .help = "Continue the interrupted run in this folder from its last checkpoint",
+     .help = "Continue the run in this folder from its last checkpoint: an interrupted run "
+             "to its end, a finished one to a larger --steps",
      .with_resume = true,
      .sweep_owned = "hnn sweep resumes interrupted runs by itself",
      .lands = Lands::kResume},
@@ -336,6 +347,9 @@ void apply(const TrainOption& option, const json& v, RunOptions& o) {
     case Lands::kResume:
       o.out = v.get<std::string>();
       o.resume = true;
+      return;
+    case Lands::kForce:
+      o.force = v.get<bool>();
       return;
     case Lands::kTaskSetting:
       o.task_settings[std::string(option.key)] = v;

@@ -61,6 +61,7 @@ enum class Lands {
   kTaskSettings,
   kCheckpointEvery,
   kResume,  ///< out, with resume set: the rest comes from the checkpoint (run.h resume_options)
+  kForce,
   kTaskSetting
 };
 
@@ -71,8 +72,10 @@ struct TrainOption {
   std::string_view group = "";  ///< --help's heading; "" the general options
   std::string_view default_shown = "";  ///< --help's default: RunOptions{}'s value, as text
   bool with_resume = false;             ///< may be given with --resume: cannot change a result
-  std::string_view sweep_owned = "";    ///< why `hnn sweep` sets it itself; "" a sweep key
-  int sweep_rank = -1;  ///< a sweep key's place in run folder names and table columns
+  /// May be given with --resume to continue the run further (--steps: resume_options, run.h).
+  bool continues_resume = false;
+  std::string_view sweep_owned = "";  ///< why `hnn sweep` sets it itself; "" a sweep key
+  int sweep_rank = -1;                ///< a sweep key's place in run folder names and table columns
   AppliesTo applies_to = AppliesTo::kEveryTask;
   Lands lands = Lands::kTaskSetting;
   /// The task settings' key (kTaskSetting), or RunSettings::to_json's key; "": not recorded.

@@ -109,6 +109,10 @@ json RunSettings::to_json() const {
   for (const TrainOption& option : train_options())
     if (recorded(option)) j[std::string(option.key)] = recorded_value(option, *this);
   j["weight_decay"] = train.weight_decay;  // no option sets it: each task's TrainConfig does
+  // Facts of a run rather than options; absent where they do not apply (runs of the tasks
+  // without a data file, runs trained in one go), so those runs' files keep their keys.
+  if (!data_sha256.empty()) j["data_sha256"] = data_sha256;
+  if (!continued_from.empty()) j["continued_from"] = continued_from;
   return j;
 }
 
@@ -124,6 +128,9 @@ RunOptions options_from_json(const json& j, const std::string& where) {
       apply(option, from_record(option, value), o);
     }
     if (j.contains("weight_decay")) o.weight_decay = j["weight_decay"].get<double>();
+    if (j.contains("data_sha256")) o.data_sha256 = j["data_sha256"].get<std::string>();
+    if (j.contains("continued_from"))
+      o.continued_from = j["continued_from"].get<std::vector<int>>();
   } catch (const std::exception& e) {
     throw Error(fmt::format("{} does not hold a run's settings: {}", where, e.what()));
   }

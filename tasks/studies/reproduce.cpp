@@ -126,6 +126,7 @@ std::vector<RunOptions> plan_runs(const ReproduceOptions& o,
                      .threads = std::max(1, int(std::thread::hardware_concurrency()) / o.jobs),
                      .steps = o.steps,
                      .out = run_dir(o, task, model, seed),
+                     .force = true,  // OUT's runs are reproduce's own: run again, replaced
                      .quiet = true};
         validate(r);
         runs.push_back(r);

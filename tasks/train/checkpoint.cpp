@@ -138,10 +138,11 @@ void load_train_checkpoint(const fs::path& dir, const TrainState& state, nn::Mod
 
 template <typename T>
 RunCheckpoints<T>::RunCheckpoints(fs::path dir, long every, long total_steps, json run,
-                                  std::uint64_t data_hash)
+                                  std::uint64_t data_hash, long restored_steps)
     : dir_(std::move(dir)),
       every_(every > 0 ? every : std::max(1L, total_steps / 10)),
       total_steps_(total_steps),
+      restored_steps_(restored_steps > 0 ? restored_steps : total_steps),
       run_(std::move(run)),
       data_hash_(data_hash) {}
 
@@ -170,9 +171,9 @@ void RunCheckpoints<T>::save(long step, Objective<T>& objective, const nn::Adam<
 template <typename T>
 TrainState RunCheckpoints<T>::restore(Objective<T>& objective, nn::Adam<T>& adam) {
   TrainState state = read_train_state(dir_);
-  HNN_TASKS_CHECK(state.total_steps == total_steps_,
+  HNN_TASKS_CHECK(state.total_steps == restored_steps_,
                   "the checkpoint in '{}' is of a run of {} steps, not {}", dir_.string(),
-                  state.total_steps, total_steps_);
+                  state.total_steps, restored_steps_);
   HNN_TASKS_CHECK(state.data_hash == data_hash_,
                   "the training data differ from those of the checkpoint in '{}'", dir_.string());
   load_train_checkpoint<T>(dir_, state, objective.model(), adam);

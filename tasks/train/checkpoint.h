@@ -58,8 +58,10 @@ class RunCheckpoints {
  public:
   /// None when `dir` is empty; every `every` steps (0: a tenth of `total_steps`) and at the last.
   /// `run` (the run's settings) and `data_hash` (Objective::data_fingerprint) go in every one.
+  /// `restored_steps`: the step count of the run restore() expects (0: `total_steps`); another
+  /// when a finished run is continued to `total_steps`.
   RunCheckpoints(std::filesystem::path dir, long every, long total_steps, nlohmann::json run,
-                 std::uint64_t data_hash);
+                 std::uint64_t data_hash, long restored_steps = 0);
 
   bool enabled() const { return !dir_.empty(); }
   bool due(long step) const { return enabled() && (step % every_ == 0 || step == total_steps_); }
@@ -79,6 +81,7 @@ class RunCheckpoints {
   std::filesystem::path dir_;
   long every_;
   long total_steps_;
+  long restored_steps_;
   nlohmann::json run_;
   std::uint64_t data_hash_;
   long last_saved_ = 0;

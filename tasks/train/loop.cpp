@@ -112,7 +112,7 @@ class Loop {
         o_(o),
         adam_(checked(objective.parameter_groups())),
         checkpoints_(o.checkpoint_dir, o.checkpoint_every, o.steps, o.run_settings,
-                     objective.data_fingerprint()) {
+                     objective.data_fingerprint(), o.checkpoint_steps) {
     check_groups(objective, adam_.parameters());
     for (std::size_t g = 0; g < adam_.group_count(); ++g) base_lr_.push_back(adam_.options(g).lr);
   }

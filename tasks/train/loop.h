@@ -49,6 +49,9 @@ struct LoopOptions {
   long checkpoint_every = 0;
   /// Continue from the checkpoint in checkpoint_dir instead of starting at step 0.
   bool resume = false;
+  /// With resume: the steps of the finished run the checkpoint is of, when this run goes on past
+  /// them to `steps` (0: the checkpoint is of a run of `steps`).
+  long checkpoint_steps = 0;
   /// The run's settings, stored in every checkpoint (for `hnn train --resume`).
   nlohmann::json run_settings{};
   /// Polled after every step: when requested, training checkpoints and throws

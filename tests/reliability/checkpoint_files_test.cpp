@@ -12,6 +12,7 @@
 #include "nn/hnn.h"
 #include "nn/parameter_file.h"
 #include "reliability_util.h"
+#include "tasks/data/file_digest.h"
 #include "tasks/experiments/registry.h"
 #include "tasks/field/field_model_run.h"
 #include "tasks/field/field_task.h"
@@ -162,12 +163,27 @@ TEST(CheckpointData, ChangedDataFileIsRefused) {
   ASSERT_NE(at, std::string::npos);
   text[at + 17] = '7';
   write_text(data, text);
-  const auto before = snapshot(run);
+  auto before = snapshot(run);
+  const nlohmann::json state = read_json(run / "checkpoint" / "state.json");
+  const std::string recorded = state["run"]["data_sha256"];
   const Result r = run_hnn({"train", "--resume", run.string(), "--quiet"}, dir.path());
   EXPECT_EQ(r.code, 1);
-  EXPECT_EQ(r.err, fmt::format("hnn: error: the training data differ from those of the "
-                               "checkpoint in '{}'\n",
-                               (run / "checkpoint").string()));
+  EXPECT_EQ(r.err, fmt::format("hnn: error: '{}' is not the data file of run '{}' (its SHA-256 is "
+                               "{}..., the run's {}...): give the run's own file with --data "
+                               "FILE\n",
+                               data.string(), run.string(), tasks::file_sha256(data).substr(0, 12),
+                               recorded.substr(0, 12)));
+  EXPECT_TRUE(snapshot(run) == before);
+  // A checkpoint from before the checksum: the fingerprint of the training data refuses it.
+  nlohmann::json old = state;
+  old["run"].erase("data_sha256");
+  write_text(run / "checkpoint" / "state.json", old.dump());
+  before = snapshot(run);
+  const Result unsummed = run_hnn({"train", "--resume", run.string(), "--quiet"}, dir.path());
+  EXPECT_EQ(unsummed.code, 1);
+  EXPECT_EQ(unsummed.err, fmt::format("hnn: error: the training data differ from those of the "
+                                      "checkpoint in '{}'\n",
+                                      (run / "checkpoint").string()));
   EXPECT_TRUE(snapshot(run) == before);
 }
 

@@ -128,7 +128,9 @@ TEST_F(PixelResume, StoppedTwiceAndResumedEqualsUninterruptedBitForBit) {
   const nlohmann::json metrics = tasks::run_training(resumed);
   EXPECT_EQ(metrics["steps"], kSteps);
   expect_same_as_whole(run);
-  EXPECT_NO_THROW(tasks::check_no_unfinished_run(run));  // finished: a fresh run may replace it
+  EXPECT_NO_THROW(tasks::check_no_unfinished_run(run));  // finished: only --force replaces it
+  EXPECT_NO_THROW(tasks::check_new_run_folder(run, /*force=*/true));
+  EXPECT_THROW(tasks::check_new_run_folder(run, /*force=*/false), tasks::Error);
 }
 
 // The program resumes the library's checkpoint (the task's settings come from it), is killed

@@ -63,10 +63,10 @@ inline nlohmann::json read_json(const fs::path& path) {
   return nlohmann::json::parse(read_text(path));
 }
 
-/// A child hnn process; stdout and stderr go to files in `dir`.
+/// A child hnn process; stdout and stderr go to files in `dir`; it works in `cwd` when given.
 class Child {
  public:
-  Child(const std::vector<std::string>& args, const fs::path& dir)
+  Child(const std::vector<std::string>& args, const fs::path& dir, const fs::path& cwd = {})
       : out_(dir / "child.out"), err_(dir / "child.err"), args_(args) {
     args_.insert(args_.begin(), HNN_EXE);
     std::vector<char*> argv;  // built before fork: the child only opens, dups and execs
@@ -78,6 +78,7 @@ class Child {
       const int err = ::open(err_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
       ::dup2(out, 1);
       ::dup2(err, 2);
+      if (!cwd.empty() && ::chdir(cwd.c_str()) != 0) ::_exit(126);
       ::execv(argv[0], argv.data());
       ::_exit(127);
     }
@@ -119,9 +120,10 @@ struct Result {
   std::string out, err;
 };
 
-/// Runs hnn with `args` to the end, working files in `dir`.
-inline Result run_hnn(const std::vector<std::string>& args, const fs::path& dir) {
-  Child child(args, dir);
+/// Runs hnn with `args` to the end, working files in `dir`; in the working folder `cwd` if given.
+inline Result run_hnn(const std::vector<std::string>& args, const fs::path& dir,
+                      const fs::path& cwd = {}) {
+  Child child(args, dir, cwd);
   const int status = child.wait();
   Result r;
   r.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);

@@ -186,9 +186,9 @@ TEST_F(ResumeCli, SigintStopsAfterTheStepCheckpointsAndSaysHowToResume) {
   const Result fresh = run_hnn(long_run(run, "1000"), dir_.path());
   EXPECT_EQ(fresh.code, 1);
   EXPECT_EQ(fresh.err, fmt::format("hnn: error: '{0}' holds an unfinished run (step {1} of "
-                                   "30000): continue it with `hnn train --resume {0}`, or choose "
-                                   "another --out, or delete '{2}'\n",
-                                   run.string(), step, checkpoint_dir(run).string()));
+                                   "30000): continue it with `hnn train --resume {0}`, or replace "
+                                   "it with --force, or choose another --out\n",
+                                   run.string(), step));
   const Result resumed = run_hnn({"train", "--resume", run.string(), "--quiet"}, dir_.path());
   ASSERT_EQ(resumed.code, 0) << resumed.err;
   expect_same_as_whole(run);
@@ -250,16 +250,18 @@ TEST(ResumeOptions, ConflictsAndMissingCheckpointsGetOneLine) {
   EXPECT_EQ(none.err, fmt::format("hnn: error: no checkpoint in '{0}/checkpoint' (cannot read "
                                   "'{0}/checkpoint/state.json')\n",
                                   dir.path().string()));
-  // Every setting of the run is refused next to --resume (the checkpoint's are used).
+  // Every setting of the run is refused next to --resume (the checkpoint's are used); --steps
+  // continues a finished run and --data names its moved data file (continue_run_test.cpp,
+  // run_folders_test.cpp).
   const std::vector<std::vector<std::string>> settings = {
-      {"--model", "baseline"}, {"--steps", "5"},  {"--seed", "2"}, {"--dtype", "float"},
-      {"--batch", "5"},        {"--hidden", "4"}, {"--lr", "0.1"}, {"--data", "x.txt"},
-      {"--out", "elsewhere"},  {"spring"}};
+      {"--model", "baseline"},     {"--seed", "2"}, {"--dtype", "float"},   {"--batch", "5"},
+      {"--hidden", "4"},           {"--lr", "0.1"}, {"--out", "elsewhere"}, {"--force"},
+      {"--lr-schedule", "cosine"}, {"spring"}};
   for (const std::vector<std::string>& setting : settings) {
     std::vector<std::string> args = {"train", "--resume", dir.path().string()};
     args.insert(args.end(), setting.begin(), setting.end());
     const Result both = run_hnn(args, dir.path());
-    const std::string name = setting.size() == 1 ? "task" : setting[0];
+    const std::string name = setting[0].starts_with("--") ? setting[0] : "task";
     EXPECT_EQ(both.code, 1) << name;
     EXPECT_EQ(both.err, "hnn: error: " + name +
                             " cannot be combined with --resume: a resumed run keeps its own "

@@ -15,7 +15,10 @@ void add_evaluate_command(CLI::App& app) {
   cmd->add_option("run", *dir, "Run folder written by `hnn train`")
       ->required()
       ->check(CLI::ExistingDirectory);
-  cmd->add_option("--data", *data, "Evaluate on another measured-data file")
+  cmd->add_option("--data", *data,
+                  "Evaluate on this measured-data file instead of the run's own: another file "
+                  "of the same format, or the run's own at a new place (its SHA-256 is not "
+                  "checked)")
       ->check(CLI::ExistingFile);
   cmd->add_flag("--write", *write, "Also rewrite the run's rollout.csv and evaluation.json");
   cmd->callback([=] {

@@ -15,12 +15,12 @@ namespace hnn::app {
 namespace {
 
 struct ExportOptions {
-  std::string run, format, out;
+  std::string run, format, out, data;
 };
 
 void run_export(const ExportOptions& o) {
   const nn::ExportFormat format = nn::parse_export_format(o.format);
-  const tasks::LoadedRun loaded = tasks::load_run(o.run);
+  const tasks::LoadedRun loaded = tasks::load_run(o.run, o.data);
   const std::unique_ptr<nn::DynamicsModel<double>> in_data_units =
       loaded.run->model_in_data_units();
   const nn::DynamicsModel<double>& model = *in_data_units;
@@ -40,6 +40,10 @@ void add_export_command(CLI::App& app) {
       ->check(CLI::ExistingDirectory);
   cmd->add_option("--format", o->format, "c or json")->required();
   cmd->add_option("--out", o->out, "The file to write")->required();
+  cmd->add_option("--data", o->data,
+                  "The run's own data file at a new place (measured-data runs: the data set the "
+                  "units; a file whose SHA-256 differs from the run's is refused)")
+      ->check(CLI::ExistingFile);
   cmd->callback([o] { run_export(*o); });
 }
 

@@ -31,7 +31,9 @@ void add_reproduce_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--steps", *steps, "Override every task's step count (quick looks)")
       ->check(positive_integer());
-  cmd->add_option("--out", options->out, "Results folder")->capture_default_str();
+  cmd->add_option("--out", options->out,
+                  "Results folder (its run folders are replaced when run again)")
+      ->capture_default_str();
   cmd->add_flag("!--no-reversibility", options->reversibility,
                 "Skip the reversibility report (the table only, sooner)");
   cmd->callback([=] {

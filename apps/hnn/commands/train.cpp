@@ -8,6 +8,7 @@
 #include <csignal>
 #include <cstdint>
 #include <cstdio>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -165,14 +166,17 @@ tasks::RunOptions run_options(const CLI::App& cmd, const std::vector<Given>& giv
   tasks::RunOptions o;
   if (const auto resume = std::find_if(asked.begin(), asked.end(), is(tasks::Lands::kResume));
       resume != asked.end()) {
+    std::optional<int> steps;  // more steps: a finished run continued
     for (std::size_t i : asked) {
-      if (!table[i].with_resume) {
+      if (table[i].continues_resume) {
+        steps = given_value(table[i], given[i]).get<int>();
+      } else if (!table[i].with_resume) {
         throw std::invalid_argument(
             fmt::format("{} cannot be combined with --resume: a resumed run keeps its own settings",
                         cli_name(table[i])));
       }
     }
-    o = tasks::resume_options(given[*resume].text);
+    o = tasks::resume_options(given[*resume].text, steps);
   } else if (const auto task = std::find_if(asked.begin(), asked.end(), is(tasks::Lands::kTask));
              task == asked.end() || given[*task].text.empty()) {
     throw std::invalid_argument("train needs a TASK (or --resume DIR)");
@@ -200,11 +204,8 @@ void add_train_command(CLI::App& app) {
   }
   cmd->callback([cmd, given] {
     tasks::RunOptions o = run_options(*cmd, *given);
-    if (!o.resume) {
-      if (o.out.empty()) o.out = std::filesystem::path("runs") / o.task / nn::to_string(o.model);
-      tasks::check_no_unfinished_run(o.out);
-    }
-    train_until_done_or_stopped(o);
+    if (!o.resume && o.out.empty()) o.out = tasks::default_run_folder(o);
+    train_until_done_or_stopped(o);  // run_training refuses a folder holding a run: see --force
   });
 }
 

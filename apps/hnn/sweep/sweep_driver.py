@@ -73,6 +73,9 @@ def run_one(hnn, out, name, args, threads):
             log("found-done")
             return {"status": "done", "skipped": True, "host": host, "worker": str(worker)}
         resume = _os.path.exists(_os.path.join(run, "checkpoint", "state.json"))
+        failed_file = _os.path.join(run, "sweep_failed.txt")
+        if not resume and _os.path.exists(failed_file):
+            _os.remove(failed_file)  # retried: hnn train starts only in a folder holding nothing
         cmd = ([hnn, "train", "--resume", run] if resume else [hnn, "train", *args, "--out", run])
         cmd += ["--threads", str(threads), "--quiet"]
         if _shutil.which("setpriv"):  # the run dies with its worker, not orphaned beside a retry
@@ -86,7 +89,6 @@ def run_one(hnn, out, name, args, threads):
         reason = next((l for l in reversed(lines) if l.startswith("hnn: error:")),
                       lines[-1] if lines else "")
         reason = reason.replace("hnn: error: ", "", 1)
-        failed_file = _os.path.join(run, "sweep_failed.txt")
         if proc.returncode == 0 and finished():
             info = {"host": host, "worker": str(worker), "seconds": seconds, "resumed": resume}
             with open(_os.path.join(run, "sweep.json"), "w") as f:
