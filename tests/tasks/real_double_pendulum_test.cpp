@@ -63,8 +63,10 @@ TEST(RealDoublePendulum, ShortLnnAndBaselineRunsLearnAndFollowTheMeasurements) {
   }
   // `hnn rollout` writes the measured paths beside the model's.
   const LoadedRun run = load_run(dir / "baseline");
-  const std::string csv = run.run->rollout_csv({.points = 11, .trajectories = 2});
-  EXPECT_NE(csv.find("\nmeasured,0,0,"), std::string::npos) << csv.substr(0, 200);
+  const RolloutOutput out = run.run->rollout({.points = 11, .trajectories = 2});
+  EXPECT_EQ(out.trajectories, 2);
+  const std::string& csv = out.csv;
+  EXPECT_NE(csv.find("\ndata,0,0,"), std::string::npos) << csv.substr(0, 200);
   EXPECT_NE(csv.find("\nbaseline,1,"), std::string::npos);
 }
 
