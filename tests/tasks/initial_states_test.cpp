@@ -40,22 +40,17 @@ TEST_F(InitialStatesFile, NamesOrNumberedColumnsInAnyOrder) {
 }
 
 TEST_F(InitialStatesFile, AnUnknownMissingOrRepeatedColumnOrABadCellIsNamed) {
-  const std::string unknown = write("u.csv", "q,r\n1,2\n");
-  EXPECT_EQ(
-      error_of([&] { states_from_file(unknown, kNames); }),
-      unknown + ": header: column 'r' is not a state column; the run's are q, p (or x_0, x_1)");
-  const std::string missing = write("m.csv", "q\n1\n");
-  EXPECT_EQ(error_of([&] { states_from_file(missing, kNames); }),
-            missing + ": header: no column 'p'; a state has q, p (or x_0, x_1)");
-  const std::string twice = write("t.csv", "q,x_0,p\n1,1,2\n");
-  EXPECT_EQ(error_of([&] { states_from_file(twice, kNames); }),
-            twice + ": header: columns 'q' and 'x_0' both name state column 'q'");
-  const std::string cell = write("c.csv", "q,p\n1,2\n1,two\n");
-  EXPECT_EQ(error_of([&] { states_from_file(cell, kNames); }),
-            cell + ":3: column 'p': 'two' is not a number");
-  const std::string width = write("w.csv", "q,p\n1,2,3\n");
-  EXPECT_EQ(error_of([&] { states_from_file(width, kNames); }),
-            width + ":2: 3 cells where the header names 2 columns");
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"q,r\n1,2\n",
+       ": header: column 'r' is not a state column; the run's are q, p (or x_0, x_1)"},
+      {"q\n1\n", ": header: no column 'p'; a state has q, p (or x_0, x_1)"},
+      {"q,x_0,p\n1,1,2\n", ": header: columns 'q' and 'x_0' both name state column 'q'"},
+      {"q,p\n1,2\n1,two\n", ":3: column 'p': 'two' is not a number"},
+      {"q,p\n1,2,3\n", ":2: 3 cells where the header names 2 columns"}};
+  for (std::size_t i = 0; i < cases.size(); ++i) {
+    const std::string file = write("bad" + std::to_string(i) + ".csv", cases[i].first);
+    EXPECT_EQ(error_of([&] { states_from_file(file, kNames); }), file + cases[i].second);
+  }
 }
 
 }  // namespace
