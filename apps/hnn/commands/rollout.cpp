@@ -21,7 +21,8 @@ struct RolloutOptions {
 }  // namespace
 
 void add_rollout_command(CLI::App& app) {
-  auto* cmd = app.add_subcommand("rollout", "Roll out a trained model and the true system");
+  auto* cmd = app.add_subcommand(
+      "rollout", "Roll out a trained model (and the true system) from test states or your own");
   auto o = std::make_shared<RolloutOptions>();
   cmd->add_option("run", o->run, "Run folder written by `hnn train`")
       ->required()
