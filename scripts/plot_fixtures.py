@@ -19,20 +19,23 @@ KEYS = ["train_loss", "test_loss", "energy_mse"]
 MODELS = ["baseline", "hnn"]
 
 
-def write_rollout(path, t, trajs):
-    """trajs: list of (true states T x d, pred states T x d, true E, pred E, learned H), any of
-    the last three None for empty cells; t: the times, shared or a list with one per trajectory."""
+def write_rollout(path, t, trajs, model, truth="true", names=None):
+    """rollout.csv as hnn writes it (tasks/report/rollout_csv.h): per trajectory the rows of the
+    truth (source `truth`) and of `model`. trajs: list of (true states T x d, pred states T x d,
+    true E, pred E, learned H), any of the last three None for empty cells; t: the times, shared
+    or a list with one per trajectory; names: the state's columns (default x_0..x_{d-1})."""
     d = trajs[0][0].shape[1]
-    header = (["traj", "t"] + [f"true_{i}" for i in range(d)] + [f"pred_{i}" for i in range(d)]
-              + ["true_energy", "pred_energy", "learned_h"])
+    names = names or [f"x_{i}" for i in range(d)]
     with open(path, "w") as f:
-        f.write(",".join(header) + "\n")
+        f.write(",".join(["source", "traj", "t"] + names + ["energy", "learned_h"]) + "\n")
         for k, (true, pred, e_true, e_pred, h) in enumerate(trajs):
-            for i, ti in enumerate(t[k] if isinstance(t, list) else t):
-                cells = [str(k), f"{ti:.6g}"] + [f"{v:.9g}" for v in true[i]]
-                cells += [f"{v:.9g}" for v in pred[i]]
-                cells += ["" if e is None else f"{e[i]:.9g}" for e in (e_true, e_pred, h)]
-                f.write(",".join(cells) + "\n")
+            times = t[k] if isinstance(t, list) else t
+            for source, states, energy, learned in ((truth, true, e_true, None),
+                                                     (model, pred, e_pred, h)):
+                for i, ti in enumerate(times):
+                    cells = [source, str(k), f"{ti:.6g}"] + [f"{v:.9g}" for v in states[i]]
+                    cells += ["" if e is None else f"{e[i]:.9g}" for e in (energy, learned)]
+                    f.write(",".join(cells) + "\n")
 
 
 def write_loss_curve(path, final_train, final_test, steps):
@@ -52,7 +55,7 @@ def write_model(root, task, model, metrics, steps, rollout):
                        n_rollouts=3, train_seconds=1.0, **metrics), f)
     write_loss_curve(os.path.join(folder, "loss_curve.csv"), metrics["train_loss"],
                      metrics["test_loss"], steps)
-    write_rollout(os.path.join(folder, "rollout.csv"), *rollout)
+    write_rollout(os.path.join(folder, "rollout.csv"), *rollout, model)
 
 
 def spring_rollouts(model):
@@ -172,7 +175,8 @@ def write_data_run(folder, model, **rollout_options):
         metrics.update(learned_h_drift=2.5e-3, learned_h_drift_relative=1e-3)
     with open(os.path.join(folder, "metrics.json"), "w") as f:
         json.dump(metrics, f)
-    write_rollout(os.path.join(folder, "rollout.csv"), *data_rollouts(model, **rollout_options))
+    write_rollout(os.path.join(folder, "rollout.csv"), *data_rollouts(model, **rollout_options),
+                  model, truth="data", names=metrics["state_names"])
     return folder
 
 

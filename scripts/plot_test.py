@@ -94,6 +94,26 @@ class PlotTest(unittest.TestCase):
         self.assertIn(path, run.stderr)
         self.assertNotIn("Traceback", run.stderr)
 
+    def test_a_rollout_csv_not_in_the_one_layout_is_an_error_naming_it(self):
+        """rollout.csv is source,traj,t,<state columns>,energy,learned_h with the rows of one
+        truth and one model: the old side-by-side layout, or two models, are refused by name."""
+        folder = os.path.join(self.data, "old_layout")
+        shutil.rmtree(folder, ignore_errors=True)
+        shutil.copytree(self.data_runs[1], folder)
+        path = os.path.join(folder, "rollout.csv")
+        for content, message in (
+                ("traj,t,true_0,pred_0,true_energy,pred_energy,learned_h\n0,0,1,1,,,\n",
+                 "header lacks column(s) source, energy"),
+                ("source,traj,t,q,energy,learned_h\ndata,0,0,1,,\nhnn,0,0,1,,\n"
+                 "baseline,0,0,1,,\n", "sources data,hnn,baseline")):
+            with open(path, "w") as f:
+                f.write(content)
+            run = run_plot("--runs", folder, "--out", os.path.join(self.data, "old_out"))
+            self.assertEqual(run.returncode, 1, run.stderr)
+            self.assertIn(f"{path}: ", run.stderr)
+            self.assertIn(message, run.stderr)
+            self.assertNotIn("Traceback", run.stderr)
+
     def test_non_numeric_cell_is_an_error_naming_file_and_column(self):
         folder = self.copy_results("bad_cell")
         path = os.path.join(folder, "two-body", "hnn", "loss_curve.csv")

@@ -8,6 +8,7 @@
 
 #include "autodiff/parallel.h"
 #include "tasks/data/file_digest.h"
+#include "tasks/data/initial_states.h"
 #include "tasks/experiments/registry.h"
 #include "tasks/report/json_values.h"
 #include "tasks/train/checkpoint.h"
@@ -241,14 +242,20 @@ json evaluate_run(const fs::path& run_dir, const std::string& data_file, bool wr
   return metrics;
 }
 
-fs::path write_rollout(const fs::path& run_dir, const RolloutRequest& request,
-                       const fs::path& out) {
-  const LoadedRun loaded = load_run(run_dir);
-  const fs::path path =
-      out.empty() ? run_dir / fmt::format("rollout_{}.csv", request.integrator) : out;
+RolloutWritten write_rollout(const fs::path& run_dir, const RolloutCommand& command) {
+  const LoadedRun loaded = load_run(run_dir, command.data_file);
+  RolloutRequest request = command.request;
+  const std::vector<std::string> names = loaded.run->state_names();
+  if (!command.states.empty()) request.initial_states = states_from_values(command.states, names);
+  if (!command.states_file.empty())
+    request.initial_states = states_from_file(command.states_file, names);
+  RolloutOutput output = loaded.run->rollout(request);
+  const fs::path path = command.out.empty()
+                            ? run_dir / fmt::format("rollout_{}.csv", request.integrator)
+                            : command.out;
   RunFolder(path.parent_path().empty() ? "." : path.parent_path())
-      .write_text(path.filename().string(), loaded.run->rollout_csv(request));
-  return path;
+      .write_text(path.filename().string(), output.csv);
+  return {.path = path, .trajectories = output.trajectories, .notes = std::move(output.notes)};
 }
 
 json reversibility(const fs::path& run_dir, const ReversibilityOptions& options) {

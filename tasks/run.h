@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "tasks/evaluate/reversibility.h"
 #include "tasks/options.h"
@@ -61,11 +62,27 @@ LoadedRun load_run(const std::filesystem::path& run_dir, const std::string& data
 nlohmann::json evaluate_run(const std::filesystem::path& run_dir, const std::string& data_file,
                             bool write_files);
 
-/// `hnn rollout`: writes the CSV of TaskRun::rollout_csv to `out` (default
-/// RUN/rollout_<integrator>.csv) and returns its path.
-std::filesystem::path write_rollout(const std::filesystem::path& run_dir,
-                                    const RolloutRequest& request,
-                                    const std::filesystem::path& out = {});
+/// `hnn rollout`'s input: the request; its initial states as the user gave them, `--state`
+/// values or a `--states` file (neither: the run's test states); a data file replacing the
+/// run's (load_run); the CSV's path (default RUN/rollout_<integrator>.csv).
+struct RolloutCommand {
+  RolloutRequest request{};
+  std::vector<std::string> states{};
+  std::string states_file{};
+  std::string data_file{};
+  std::filesystem::path out{};
+};
+
+/// What write_rollout wrote: the CSV's path, its number of trajectories, notes for the terminal.
+struct RolloutWritten {
+  std::filesystem::path path;
+  int trajectories = 0;
+  std::vector<std::string> notes{};
+};
+
+/// `hnn rollout`: reads the initial states against the run's state columns
+/// (tasks/data/initial_states.h) and writes the CSV of TaskRun::rollout.
+RolloutWritten write_rollout(const std::filesystem::path& run_dir, const RolloutCommand& command);
 
 /// Reversibility of a run's learned field from its rollout states (t_end 0: the run's rollout
 /// span); writes run_dir/reversibility.json and returns it.

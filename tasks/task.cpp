@@ -1,5 +1,7 @@
 #include "tasks/task.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 
 #include "nn/hnn.h"
@@ -20,6 +22,22 @@ void Task::check_task_settings(const nlohmann::json& settings) const {
 
 std::unique_ptr<nn::DynamicsModel<double>> TaskRun::model_in_data_units() const {
   return nn::cast_model<double>(dynamics());
+}
+
+std::vector<std::string> TaskRun::state_names() const {
+  std::vector<std::string> names;
+  for (Eigen::Index c = 0; c < dynamics().config().dim; ++c)
+    names.push_back(fmt::format("x_{}", c));
+  return names;
+}
+
+int trajectories_to_write(const RolloutRequest& request, int available, std::string_view what) {
+  if (!request.trajectories) return std::min(RolloutRequest::kDefaultTrajectories, available);
+  HNN_TASKS_CHECK(*request.trajectories <= available,
+                  "--trajectories {} is more than the {} {} this run can start from: give at "
+                  "most {}, or your own initial states with --state or --states FILE",
+                  *request.trajectories, available, what, available);
+  return *request.trajectories;
 }
 
 void Task::write_comparison(const TaskRun&, const TaskRun&, const std::filesystem::path&) const {}

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "nn/dynamics.h"
@@ -20,13 +21,34 @@
 
 namespace hnn::tasks {
 
-/// `hnn rollout`: the learned model's paths (and the truth's) from test states.
+/// `hnn rollout`: the learned model's paths (and the truth's) from test states or given ones.
 struct RolloutRequest {
   std::string integrator = "dopri5";
   double dt = 1e-2, rtol = 1e-9;
   std::optional<double> t_end{};  // default: the evaluation's rollout span
-  int points = 200, trajectories = 5;
+  int points = 200;
+  /// How many test states to start from; unset: kDefaultTrajectories, or fewer when the run
+  /// has fewer. More than the run has is an Error (trajectories_to_write).
+  std::optional<int> trajectories{};
+  /// Given initial states, one per row, in the run's state order (TaskRun::state_names) and the
+  /// data's units; empty: the run's test states.
+  physics::Batch initial_states{};
+
+  static constexpr int kDefaultTrajectories = 5;
 };
+
+/// What `hnn rollout` wrote: the CSV (tasks/report/rollout_csv.h), how many trajectories it
+/// holds, and notes for the terminal (a truth that is unavailable, say).
+struct RolloutOutput {
+  std::string csv;
+  int trajectories = 0;
+  std::vector<std::string> notes{};
+};
+
+/// How many of the run's `available` test states (`what`: "held-out stretches", say) a
+/// request rolls out: its trajectories, or by default up to kDefaultTrajectories. Throws Error
+/// when it asks for more than there are, naming both counts and --states.
+int trajectories_to_write(const RolloutRequest& request, int available, std::string_view what);
 
 /// `loop` with the steps, learning-rate schedule and loss-curve interval of `config`: every run
 /// trains with its own settings' (TaskRun::train), whoever made the loop.
@@ -44,8 +66,12 @@ class TaskRun {
   virtual void load(const std::filesystem::path& params) = 0;
   /// The metrics of metrics.json; with a folder, also the task's evaluation files.
   virtual nlohmann::json evaluate(const RunFolder* folder) const = 0;
-  /// The CSV of `hnn rollout`.
-  virtual std::string rollout_csv(const RolloutRequest& request) const = 0;
+  /// `hnn rollout`: the model's paths (and the truth's where the run knows it) over the
+  /// request's span, from its initial states or the run's test states.
+  virtual RolloutOutput rollout(const RolloutRequest& request) const = 0;
+  /// The names of the state's columns, in order: what `hnn rollout --states FILE` names and
+  /// rollout CSVs use. By default x_0..x_{d-1}.
+  virtual std::vector<std::string> state_names() const;
 
   /// The learned field (in double) and the states its rollouts start from: the phase space, or
   /// the latent space of a task that learns one. For reversibility and the like.

@@ -102,9 +102,10 @@ def to_float(cell, path, line, column):
         raise PlotError(f"{path}:{line}: column '{column}': not a number: {cell!r}") from None
 
 
-def read_csv(path, required):
-    """Reads a numeric CSV with a header into {column: np.ndarray}. Checks the required columns
-    and that every row has as many cells as the header."""
+def read_csv(path, required, text=()):
+    """Reads a CSV with a header into {column: np.ndarray}: numbers, but the columns named in
+    `text` (such as a rollout CSV's "source") as strings. Checks the required columns and that
+    every row has as many cells as the header."""
     try:
         with open(path, newline="", encoding="utf-8") as f:
             rows = list(csv.reader(f))
@@ -123,11 +124,12 @@ def read_csv(path, required):
             continue
         if len(row) != len(header):
             raise PlotError(f"{path}:{line}: {len(row)} cells, header has {len(header)}")
-        values.append([to_float(c, path, line, h) for c, h in zip(row, header)])
+        values.append([c.strip() if h in text else to_float(c, path, line, h)
+                       for c, h in zip(row, header)])
     if not values:
         raise PlotError(f"{path}: no data rows")
-    table = np.array(values, dtype=float)
-    return {h: table[:, i] for i, h in enumerate(header)}
+    return {h: np.array([v[i] for v in values], dtype=str if h in text else float)
+            for i, h in enumerate(header)}
 
 
 def read_rows(path):

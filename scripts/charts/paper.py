@@ -188,8 +188,8 @@ be parsed is an error naming it (exit code 1). Each written file's path goes to 
 --runs draws Figure 2 of any run folders (`hnn train ... --out RUN`, e.g. of the `data` task),
 at most one per model and all of one task and the same held-out data, into DIR/fig2_<task>:
 q_1 against p_1 (names from metrics.json's "state_names"), the coordinate MSE against the time
-since each rollout's start, and the energies; without a known Hamiltonian (empty true_energy)
-the last panel is the drift of the HNN's learned H along its own rollout. A run that lacks
+since each rollout's start, and the energies; without a known Hamiltonian (the truth's rows have
+empty energy cells) the last panel is the drift of the HNN's learned H along its own rollout. A run that lacks
 metrics.json or rollout.csv, or runs of different tasks or data, are an error naming them.""")
     p.add_argument("results", nargs="?", metavar="RESULTS_DIR", help="an `hnn reproduce` folder")
     p.add_argument("--runs", nargs="+", metavar="RUN", help="`hnn train` run folders")

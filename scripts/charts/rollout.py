@@ -1,38 +1,56 @@
-"""rollout.csv of `hnn train` and `hnn reproduce` (per test trajectory: time, true and predicted
-states, energies, the HNN's learned H), and the panels that Figures 2 and 3 share: the
-coordinate MSE against time and the total energy."""
+"""rollout.csv of `hnn train` and `hnn reproduce` (per test trajectory: the truth's and the
+model's states and energies, the HNN's learned H), and the panels that Figures 2 and 3 share:
+the coordinate MSE against time and the total energy."""
 
 import numpy as np
 
 from .common import COLORS, LABELS, MODELS, PlotError, is_number, note, read_csv
 
+# rollout.csv's columns besides the state's (tasks/report/rollout_csv.h), and the sources that
+# are the truth: the true system integrated, or measured data.
+META = ("source", "traj", "t", "energy", "learned_h")
+TRUTHS = ("true", "data")
+
+
 class Rollout:
-    """rollout.csv of one model: per-trajectory time, true and predicted states and energies."""
+    """rollout.csv of one model: per trajectory the time, the true and predicted states and
+    energies, the learned H. The file holds a block of rows per source (the truth, "true" or
+    "data", and the model) and trajectory, at the same times; `names` are the state's columns."""
 
     def __init__(self, path):
-        cols = read_csv(path, ["traj", "t", "true_energy", "pred_energy", "learned_h"])
-        d = sum(1 for h in cols if h.startswith("true_") and h != "true_energy")
-        state = [f"true_{i}" for i in range(d)] + [f"pred_{i}" for i in range(d)]
-        missing = [c for c in state if c not in cols]
-        if d == 0 or missing:
-            raise PlotError(f"{path}: header needs true_0..true_{{d-1}} and pred_0..pred_{{d-1}};"
-                            f" got {','.join(cols)}")
+        cols = read_csv(path, META, text=("source",))
+        names = [h for h in cols if h not in META]
+        sources = list(dict.fromkeys(cols["source"]))
+        truths = [s for s in sources if s in TRUTHS]
+        models = [s for s in sources if s not in TRUTHS]
+        if not names or len(truths) != 1 or len(models) != 1:
+            raise PlotError(f"{path}: a rollout.csv has state columns between t and energy and"
+                            f" the rows of one truth ({' or '.join(TRUTHS)}) and one model;"
+                            f" got columns {','.join(cols)} and sources {','.join(sources)}")
         for key in ("traj", "t"):
             if not np.all(np.isfinite(cols[key])):
                 raise PlotError(f"{path}: column '{key}' has empty or non-finite cells")
-        self.path, self.d = path, d
+        self.path, self.d, self.names, self.model = path, len(names), names, models[0]
         self.show = 0  # the trajectory of the single-trajectory panels
         self.trajs = []
         for k in np.unique(cols["traj"]):
-            rows = cols["traj"] == k
-            order = np.argsort(cols["t"][rows], kind="stable")
-            pick = {name: cols[name][rows][order] for name in cols}
-            self.trajs.append({"t": pick["t"],
-                               "true": np.stack([pick[f"true_{i}"] for i in range(d)], axis=1),
-                               "pred": np.stack([pick[f"pred_{i}"] for i in range(d)], axis=1),
-                               "true_energy": pick["true_energy"],
-                               "pred_energy": pick["pred_energy"],
-                               "learned_h": pick["learned_h"]})
+            truth, pred = (self._rows(cols, source, k) for source in (truths[0], models[0]))
+            if len(truth["t"]) != len(pred["t"]) or not np.allclose(truth["t"], pred["t"]):
+                raise PlotError(f"{path}: trajectory {k:g}: the {truths[0]} and {models[0]}"
+                                " rows are not at the same times")
+            self.trajs.append({"t": truth["t"],
+                               "true": np.stack([truth[n] for n in names], axis=1),
+                               "pred": np.stack([pred[n] for n in names], axis=1),
+                               "true_energy": truth["energy"],
+                               "pred_energy": pred["energy"],
+                               "learned_h": pred["learned_h"]})
+
+    @staticmethod
+    def _rows(cols, source, traj):
+        """The numeric columns of one source's rows of one trajectory, in time order."""
+        rows = (cols["source"] == source) & (cols["traj"] == traj)
+        order = np.argsort(cols["t"][rows], kind="stable")
+        return {name: cols[name][rows][order] for name in cols if name != "source"}
 
     @property
     def shown(self):

@@ -124,12 +124,14 @@ Eigen::VectorXd row_or_empty(const Eigen::MatrixXd& m, std::size_t i) {
 
 }  // namespace
 
-std::string rollout_csv(const Rollouts& r) {
-  ComparisonCsv csv(r.truth.empty() ? 0 : r.truth[0].cols());
+std::string rollout_csv(const Rollouts& r, std::string_view model_name) {
+  RolloutCsv csv(numbered_columns("x", r.truth.empty() ? 0 : r.truth[0].cols()));
   const Eigen::VectorXd t = as_vector(r.t);
   for (std::size_t i = 0; i < r.truth.size(); ++i) {
-    csv.add(i, t, r.truth[i], r.pred[i], row_or_empty(r.true_energy, i),
-            row_or_empty(r.pred_energy, i), row_or_empty(r.learned_h, i));
+    csv.add(r.measured ? kDataSource : kTrueSource, i, t, r.truth[i],
+            row_or_empty(r.true_energy, i));
+    csv.add(model_name, i, t, r.pred[i], row_or_empty(r.pred_energy, i),
+            row_or_empty(r.learned_h, i));
   }
   return csv.str();
 }
@@ -141,16 +143,15 @@ std::string rollout_paths_csv(const physics::System& truth, const nn::DynamicsMo
     dxdt = model.field(x);
   };
   const auto* hnn = dynamic_cast<const nn::Hnn<double>*>(&model);
-  PathsCsv csv(numbered_columns("x", x0.cols()));
-  const auto add = [&](std::string_view source, const physics::Trajectory& path, bool with_h) {
-    for (Eigen::Index row = 0; row < path.states.front().rows(); ++row) {
-      const Batch states = path.path(row);
-      csv.add(source, std::size_t(row), as_vector(path.t), states, truth.energy_batch(states),
-              with_h ? Eigen::VectorXd(hnn->energy(states).col(0)) : Eigen::VectorXd());
-    }
-  };
-  add("true", integrator.integrate(truth.field(), x0, t), false);
-  add(model_name, integrator.integrate(learned, x0, t), hnn != nullptr);
+  const physics::Trajectory true_paths = integrator.integrate(truth.field(), x0, t);
+  const physics::Trajectory model_paths = integrator.integrate(learned, x0, t);
+  RolloutCsv csv(numbered_columns("x", x0.cols()));
+  for (Eigen::Index row = 0; row < x0.rows(); ++row) {
+    const Batch true_states = true_paths.path(row), states = model_paths.path(row);
+    csv.add(kTrueSource, std::size_t(row), t, true_states, truth.energy_batch(true_states));
+    csv.add(model_name, std::size_t(row), t, states, truth.energy_batch(states),
+            hnn ? Eigen::VectorXd(hnn->energy(states).col(0)) : Eigen::VectorXd());
+  }
   return csv.str();
 }
 

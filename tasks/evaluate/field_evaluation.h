@@ -5,6 +5,7 @@
 #include <functional>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <string_view>
 
 #include "nn/dynamics.h"
 #include "physics/integrator.h"
@@ -48,11 +49,12 @@ FieldEvaluation evaluate_field_model(const physics::System& truth,
 FieldEvaluation evaluate_field_model(const nn::DynamicsModel<double>& model, const Dataset& data,
                                      Rollouts rollouts);
 
-/// rollout.csv: traj,t,true_0..,pred_0..,true_energy,pred_energy,learned_h.
-std::string rollout_csv(const Rollouts& rollouts);
+/// rollout.csv (tasks/report/rollout_csv.h): per trajectory the truth ("true", or "data" when
+/// measured) and the model's prediction (source `model_name`).
+std::string rollout_csv(const Rollouts& rollouts, std::string_view model_name);
 
-/// `hnn rollout`'s CSV: the true and the learned paths from each row of x0 with `integrator` at
-/// times t, as source,traj,t,x_0..x_{d-1},energy,learned_h (source "true" or `model_name`).
+/// `hnn rollout`'s CSV (tasks/report/rollout_csv.h): per row of x0 the true and the learned
+/// paths, both with `integrator` at times t (sources "true" and `model_name`).
 std::string rollout_paths_csv(const physics::System& truth, const nn::DynamicsModel<double>& model,
                               std::string_view model_name, const Batch& x0,
                               const physics::Integrator& integrator, const std::vector<double>& t);

@@ -226,11 +226,13 @@ HeldOutEvaluation evaluate_held_out(const LearnedField& model, const Units& unit
   return e;
 }
 
-std::string held_out_csv(const HeldOutEvaluation& e) {
-  ComparisonCsv csv(e.rollouts.empty() ? 0 : e.rollouts[0].truth.cols(), {.times = 12});
+std::string held_out_csv(const HeldOutEvaluation& e, const std::vector<std::string>& columns,
+                         std::string_view model_name) {
+  RolloutCsv csv(columns, {.times = 12});
   for (std::size_t i = 0; i < e.rollouts.size(); ++i) {
     const HeldOutRollout& r = e.rollouts[i];
-    csv.add(i, r.t, r.truth, r.pred, r.true_energy, r.pred_energy, r.learned_h);
+    csv.add(kDataSource, i, r.t, r.truth, r.true_energy);
+    csv.add(model_name, i, r.t, r.pred, r.pred_energy, r.learned_h);
   }
   return csv.str();
 }

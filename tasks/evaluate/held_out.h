@@ -6,6 +6,7 @@
 
 #include <nlohmann/json.hpp>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "tasks/data/measured_dataset.h"
@@ -80,8 +81,10 @@ HeldOutEvaluation evaluate_held_out(const LearnedField& model, const Units& unit
                                     const std::vector<HeldOut>& held_out, Eigen::Index coordinates,
                                     const Batch& train_z, const HeldOutOptions& options = {});
 
-/// rollout.csv of a data run: traj,t,true_0..,pred_0..,true_energy,pred_energy,learned_h, each
-/// held-out stretch at its own times (true_energy and pred_energy empty without a known H).
-std::string held_out_csv(const HeldOutEvaluation& evaluation);
+/// rollout.csv of a data run (tasks/report/rollout_csv.h): per held-out stretch, at its own
+/// times, the data ("data") and the prediction (source `model_name`), with the state's
+/// `columns`; the energy column is empty without a known H.
+std::string held_out_csv(const HeldOutEvaluation& evaluation,
+                         const std::vector<std::string>& columns, std::string_view model_name);
 
 }  // namespace hnn::tasks

@@ -129,35 +129,49 @@ class DataRun : public FieldModelRun {
     m["units"] = p_.units.to_json();
     m["state_names"] = p_.measured.state_names;
     m["data"] = describe(p_.measured);
-    if (folder) folder->write_text("rollout.csv", held_out_csv(held));
+    if (folder) {
+      folder->write_text("rollout.csv",
+                         held_out_csv(held, p_.measured.state_names, nn::to_string(s_.model)));
+    }
     return m;
   }
 
-  // `hnn rollout`: the measured held-out stretches ("data") and the model's paths from their
-  // first states with the requested integrator, in the file's units.
-  std::string rollout_csv(const RolloutRequest& r) const override {
-    const Units& u = p_.units;
-    const auto integrator = physics::make_integrator(
-        r.integrator, {.dt = r.dt / u.time, .rtol = r.rtol, .atol = r.rtol * 1e-3});
-    const LearnedField model = learned_field(dynamics());
+  // `hnn rollout`, in the file's units: from each initial state (given, or the first state of
+  // a held-out stretch, whose data come too) the true system when --hamiltonian gave one, over
+  // the whole span, and the model. Without one the truth is the data alone, and a note says
+  // so when the span goes past them.
+  RolloutOutput rollout(const RolloutRequest& r) const override {
     const std::vector<double> t =
-        physics::linspace(0.0, r.t_end.value_or(rollout_span() * u.time), r.points);
-    std::vector<double> t_model(t.size());
-    std::transform(t.begin(), t.end(), t_model.begin(), [&](double v) { return v / u.time; });
-    PathsCsv csv(p_.measured.state_names, {.times = 12});
+        physics::linspace(0.0, r.t_end.value_or(rollout_span() * p_.units.time), r.points);
+    const auto integrator =
+        physics::make_integrator(r.integrator, {.dt = r.dt, .rtol = r.rtol, .atol = r.rtol * 1e-3});
+    RolloutCsv csv(p_.measured.state_names, {.times = 12});
+    RolloutOutput out;
+    const bool given = r.initial_states.rows() > 0;
     const auto& held = p_.measured.held_out;
-    for (std::size_t i = 0; i < held.size() && int(i) < r.trajectories; ++i) {
-      csv.add("data", i, held[i].t.array() - held[i].t(0), held[i].x, energy(held[i].x));
-      const Batch z =
-          integrator->integrate(model.field, u.to_model(Batch(held[i].x.topRows(1))), t_model)
-              .path(0);
-      const Batch x = u.to_file(z);
-      csv.add(nn::to_string(s_.model), i, t, x, energy(x),
-              model.hamiltonian ? Eigen::VectorXd(model.hamiltonian(z) * u.energy_to_file())
-                                : Eigen::VectorXd());
+    out.trajectories = given ? int(r.initial_states.rows())
+                             : trajectories_to_write(r, int(held.size()), "held-out stretches");
+    double data_end = INFINITY;
+    for (int i = 0; i < out.trajectories; ++i) {
+      const auto k = std::size_t(i);
+      const Batch x0 = given ? Batch(r.initial_states.row(i)) : Batch(held[k].x.topRows(1));
+      if (!given) {
+        csv.add(kDataSource, k, held[k].t.array() - held[k].t(0), held[k].x, energy(held[k].x));
+        data_end = std::min(data_end, held[k].t(held[k].t.size() - 1) - held[k].t(0));
+      }
+      if (p_.truth) {
+        const Batch x = integrator->integrate(p_.truth->field(), x0, t).path(0);
+        csv.add(kTrueSource, k, t, x, energy(x));
+      }
+      add_model_path(csv, k, x0, r, t);
     }
-    return csv.str();
+    out.csv = csv.str();
+    if (!p_.truth && (given || t.back() > data_end))
+      out.notes.push_back(no_truth(given, data_end, t.back()));
+    return out;
   }
+
+  std::vector<std::string> state_names() const override { return p_.measured.state_names; }
 
   // The units folded into the weights: the first layer takes x instead of z = (x - mean) / scale
   // and the last gives H in the file's units (an HNN) or dx/dt (a baseline). Exact: an affine map
@@ -194,6 +208,37 @@ class DataRun : public FieldModelRun {
   double rollout_span() const override { return held_out_duration() / p_.units.time; }
 
  private:
+  // The note of a run without an H whose rollouts leave the data (or start from given states).
+  static std::string no_truth(bool given, double data_end, double t_end) {
+    if (given) {
+      return "data: the truth is unavailable from your states: the run has no H (train with "
+             "--hamiltonian EXPR to integrate one)";
+    }
+    return fmt::format(
+        "data: the truth is unavailable past the data: the shortest held-out "
+        "stretch ends at t = {:g} and the paths run to t = {:g}; train with "
+        "--hamiltonian EXPR to integrate a known H",
+        data_end, t_end);
+  }
+
+  // The model's path from the state x0 (one row, file units) at the file's times t:
+  // integrated in the model's units (as evaluate_held_out does, so that tolerances mean the
+  // same at any data scale; `r`'s dt is in the file's time unit) and shown in the file's.
+  void add_model_path(RolloutCsv& csv, std::size_t traj, const Batch& x0, const RolloutRequest& r,
+                      const std::vector<double>& t) const {
+    const Units& u = p_.units;
+    const auto integrator = physics::make_integrator(
+        r.integrator, {.dt = r.dt / u.time, .rtol = r.rtol, .atol = r.rtol * 1e-3});
+    std::vector<double> t_model(t.size());
+    std::transform(t.begin(), t.end(), t_model.begin(), [&](double v) { return v / u.time; });
+    const LearnedField model = learned_field(dynamics());
+    const Batch z = integrator->integrate(model.field, u.to_model(x0), t_model).path(0);
+    const Batch x = u.to_file(z);
+    csv.add(nn::to_string(s_.model), traj, t, x, energy(x),
+            model.hamiltonian ? Eigen::VectorXd(model.hamiltonian(z) * u.energy_to_file())
+                              : Eigen::VectorXd());
+  }
+
   double held_out_duration() const {
     std::vector<double> spans;
     for (const HeldOut& h : p_.measured.held_out) spans.push_back(h.t(h.t.size() - 1) - h.t(0));

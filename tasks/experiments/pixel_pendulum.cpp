@@ -88,16 +88,21 @@ class PixelRun : public TaskRun {
     return m;
   }
 
-  std::string rollout_csv(const RolloutRequest& r) const override {
+  RolloutOutput rollout(const RolloutRequest& r) const override {
     HNN_TASKS_CHECK(!r.t_end,
                     "pixel-pendulum rollouts are counted in frames: give --points "
                     "(frames + 1), not --t-end");
-    return pixel::pixel_rollout_csv(model(), data_, nn::to_string(s_.model),
-                                    {.integrator = r.integrator,
-                                     .dt = r.dt,
-                                     .rtol = r.rtol,
-                                     .frames = r.points - 1,
-                                     .trajectories = r.trajectories});
+    HNN_TASKS_CHECK(r.initial_states.rows() == 0,
+                    "pixel-pendulum rollouts start from the test trials' frames: --state and "
+                    "--states give states of the tasks that learn in phase space");
+    const int n = trajectories_to_write(r, data_.test_trials(), "test trials");
+    return {.csv = pixel::pixel_rollout_csv(model(), data_, nn::to_string(s_.model),
+                                            {.integrator = r.integrator,
+                                             .dt = r.dt,
+                                             .rtol = r.rtol,
+                                             .frames = r.points - 1,
+                                             .trajectories = n}),
+            .trajectories = n};
   }
 
   const nn::DynamicsModel<double>& dynamics() const override { return model().dynamics(); }

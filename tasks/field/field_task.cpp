@@ -53,7 +53,8 @@ class FieldRun : public FieldModelRun {
     task_.add_metrics(e.rollouts, e.metrics);
     e.metrics["eval_seconds"] =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    if (folder) folder->write_text("rollout.csv", tasks::rollout_csv(e.rollouts));
+    if (folder)
+      folder->write_text("rollout.csv", tasks::rollout_csv(e.rollouts, nn::to_string(s_.model)));
     json m = e.metrics;
     m["training"] = training_.loss().to_json();
     if (stretches_ && !stretches_->test.empty()) {
@@ -65,13 +66,31 @@ class FieldRun : public FieldModelRun {
     return m;
   }
 
-  std::string rollout_csv(const RolloutRequest& r) const override {
+  // With a true system, it and the model from each initial state over the whole span; without
+  // one, the measured paths from the test states, or the model alone from given states.
+  RolloutOutput rollout(const RolloutRequest& r) const override {
     const auto integrator =
         physics::make_integrator(r.integrator, {.dt = r.dt, .rtol = r.rtol, .atol = r.rtol * 1e-3});
-    if (!task_.has_truth()) return measured_csv(r, *integrator);
-    return rollout_paths_csv(task_.truth(), dynamics(), nn::to_string(s_.model),
-                             rollout_states(r.trajectories), *integrator,
-                             physics::linspace(0.0, r.t_end.value_or(rollout_span()), r.points));
+    const std::vector<double> t =
+        physics::linspace(0.0, r.t_end.value_or(rollout_span()), r.points);
+    const bool given = r.initial_states.rows() > 0;
+    if (!task_.has_truth() && !given) return measured_rollout(r, *integrator, t);
+    if (!task_.has_truth()) {
+      return {.csv = model_paths_csv(r.initial_states, *integrator, t),
+              .trajectories = int(r.initial_states.rows()),
+              .notes = {fmt::format("{}: the truth is unavailable from your states: the task "
+                                    "knows no H, its truth is measured data",
+                                    task_.name())}};
+    }
+    Batch x0 = r.initial_states;
+    if (!given) {
+      x0 = rollout_states(r.trajectories.value_or(RolloutRequest::kDefaultTrajectories));
+      x0.conservativeResize(trajectories_to_write(r, int(x0.rows()), "distinct test states"),
+                            Eigen::NoChange);
+    }
+    return {.csv = rollout_paths_csv(task_.truth(), dynamics(), nn::to_string(s_.model), x0,
+                                     *integrator, t),
+            .trajectories = int(x0.rows())};
   }
 
   // The evaluation's states: a generator independent of the training data's draws. Without a
@@ -119,23 +138,45 @@ class FieldRun : public FieldModelRun {
         config.trajectories, available_rollouts_);
   }
 
-  // `hnn rollout` without a truth: the measured paths ("measured", missing samples left out) and
-  // the model's from their first states with the requested integrator.
-  std::string measured_csv(const RolloutRequest& r, const physics::Integrator& integrator) const {
+  // `hnn rollout` without a truth: the measured paths ("data", missing samples left out) and
+  // the model's from their first states with the requested integrator at times t. The data
+  // stop where they end: a note says so when t goes further.
+  RolloutOutput measured_rollout(const RolloutRequest& r, const physics::Integrator& integrator,
+                                 const std::vector<double>& t) const {
     RolloutConfig config = task_.rollout_config(s_.task_settings);
-    config.trajectories = std::min(r.trajectories, available_rollouts_);
+    config.trajectories = trajectories_to_write(r, available_rollouts_, "measured test paths");
     const std::vector<Eigen::MatrixXd> paths = measured_paths(config);
-    const std::vector<double> t = physics::linspace(0.0, config.t_end, config.points);
-    const std::vector<double> model_t =
-        physics::linspace(0.0, r.t_end.value_or(config.t_end), r.points);
-    PathsCsv csv(numbered_columns("x", data_.test_x.cols()), {}, /*skip_incomplete=*/true);
-    const physics::VectorField field = learned_field(dynamics()).field;
+    RolloutCsv csv(state_names(), {}, /*skip_incomplete=*/true);
+    const std::vector<double> data_t = physics::linspace(0.0, config.t_end, config.points);
     for (std::size_t i = 0; i < paths.size(); ++i) {
-      csv.add("measured", i, t, paths[i]);
-      csv.add(nn::to_string(s_.model), i, model_t,
-              integrator.integrate(field, Batch(paths[i].topRows(1)), model_t).path(0));
+      csv.add(kDataSource, i, data_t, paths[i]);
+      add_model_path(csv, i, Batch(paths[i].topRows(1)), integrator, t);
     }
+    RolloutOutput out{.csv = csv.str(), .trajectories = int(paths.size())};
+    if (t.back() > config.t_end) {
+      out.notes.push_back(
+          fmt::format("{}: the truth is unavailable past the data: the measured "
+                      "paths end at t = {:g} and the model's run to t = {:g}",
+                      task_.name(), config.t_end, t.back()));
+    }
+    return out;
+  }
+
+  std::string model_paths_csv(const Batch& x0, const physics::Integrator& integrator,
+                              const std::vector<double>& t) const {
+    RolloutCsv csv(state_names());
+    for (Eigen::Index i = 0; i < x0.rows(); ++i)
+      add_model_path(csv, std::size_t(i), Batch(x0.row(i)), integrator, t);
     return csv.str();
+  }
+
+  // The model's path from the state x0 (one row), with its learned H when it has one.
+  void add_model_path(RolloutCsv& csv, std::size_t traj, const Batch& x0,
+                      const physics::Integrator& integrator, const std::vector<double>& t) const {
+    const LearnedField model = learned_field(dynamics());
+    const Batch x = integrator.integrate(model.field, x0, t).path(0);
+    csv.add(nn::to_string(s_.model), traj, t, x, {},
+            model.hamiltonian ? model.hamiltonian(x) : Eigen::VectorXd());
   }
 
   const FieldTask& task_;

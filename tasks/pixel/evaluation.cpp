@@ -158,7 +158,7 @@ std::string pixel_rollout_csv(const PixelModel<double>& model, const PixelData& 
   const physics::Trajectory path = integrator->integrate(
       [&dynamics](double, const physics::Batch& z, physics::Batch& dz) { dz = dynamics.field(z); },
       z0, t);
-  PathsCsv csv({"z_q", "z_p", "theta", "p"}, {.values = 9, .times = 9});
+  RolloutCsv csv({"z_q", "z_p", "theta", "p"}, {.values = 9, .times = 9});
   for (int i = 0; i < n; ++i) {
     const std::vector<physics::GymState> states = scene.rollout(
         data.states[std::size_t(data.first_frame(rows[std::size_t(i)]))], o.frames + 2);
@@ -171,7 +171,7 @@ std::string pixel_rollout_csv(const PixelModel<double>& model, const PixelData& 
       truth.row(k).tail(2) = x;
       energy(k) = scene.energy(x);
     }
-    csv.add("true", std::size_t(i), frames.head(o.frames + 1), truth, energy);
+    csv.add(kTrueSource, std::size_t(i), frames.head(o.frames + 1), truth, energy);
     const physics::Batch z = path.path(i);
     const physics::Batch pairs = model.decode(z);
     Eigen::VectorXd h;

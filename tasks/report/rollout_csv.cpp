@@ -20,15 +20,16 @@ std::vector<std::string> numbered_columns(std::string_view prefix, Eigen::Index 
   return names;
 }
 
-PathsCsv::PathsCsv(const std::vector<std::string>& columns, CsvDigits digits, bool skip_incomplete)
+RolloutCsv::RolloutCsv(const std::vector<std::string>& columns, CsvDigits digits,
+                       bool skip_incomplete)
     : csv_("source,traj,t"), digits_(digits), skip_incomplete_(skip_incomplete) {
   for (const std::string& name : columns) csv_ += "," + name;
   csv_ += ",energy,learned_h\n";
 }
 
-void PathsCsv::add(std::string_view source, std::size_t traj, const Eigen::VectorXd& t,
-                   const Eigen::MatrixXd& states, const Eigen::VectorXd& energy,
-                   const Eigen::VectorXd& learned_h) {
+void RolloutCsv::add(std::string_view source, std::size_t traj, const Eigen::VectorXd& t,
+                     const Eigen::MatrixXd& states, const Eigen::VectorXd& energy,
+                     const Eigen::VectorXd& learned_h) {
   for (Eigen::Index k = 0; k < states.rows(); ++k) {
     if (skip_incomplete_ && !states.row(k).allFinite()) continue;
     csv_ += fmt::format("{},{},{}", source, traj, csv_cell(t(k), digits_.times));
@@ -36,25 +37,6 @@ void PathsCsv::add(std::string_view source, std::size_t traj, const Eigen::Vecto
       csv_ += "," + csv_cell(states(k, c), digits_.values);
     csv_ += "," + csv_cell(at(energy, k), digits_.values) + "," +
             csv_cell(at(learned_h, k), digits_.values) + "\n";
-  }
-}
-
-ComparisonCsv::ComparisonCsv(Eigen::Index dim, CsvDigits digits) : csv_("traj,t"), digits_(digits) {
-  for (const char* which : {"true", "pred"})
-    for (const std::string& name : numbered_columns(which, dim)) csv_ += "," + name;
-  csv_ += ",true_energy,pred_energy,learned_h\n";
-}
-
-void ComparisonCsv::add(std::size_t traj, const Eigen::VectorXd& t, const Eigen::MatrixXd& truth,
-                        const Eigen::MatrixXd& pred, const Eigen::VectorXd& true_energy,
-                        const Eigen::VectorXd& pred_energy, const Eigen::VectorXd& learned_h) {
-  for (Eigen::Index k = 0; k < t.size(); ++k) {
-    csv_ += fmt::format("{},{}", traj, csv_cell(t(k), digits_.times));
-    const int d = digits_.values;
-    for (Eigen::Index c = 0; c < truth.cols(); ++c) csv_ += "," + csv_cell(truth(k, c), d);
-    for (Eigen::Index c = 0; c < pred.cols(); ++c) csv_ += "," + csv_cell(pred(k, c), d);
-    csv_ += "," + csv_cell(at(true_energy, k), d) + "," + csv_cell(at(pred_energy, k), d) + "," +
-            csv_cell(at(learned_h, k), d) + "\n";
   }
 }
 

@@ -153,7 +153,7 @@ TEST(CliTrain, ShortRunWritesTheRunFolderAndPrintsItsMetrics) {
   }
   EXPECT_EQ(lines_of(read_text(dir.path() / "loss_curve.csv")).at(0), "step,train_loss,test_loss");
   EXPECT_EQ(lines_of(read_text(dir.path() / "rollout.csv")).at(0),
-            "traj,t,true_0,true_1,pred_0,pred_1,true_energy,pred_energy,learned_h");
+            "source,traj,t,x_0,x_1,energy,learned_h");
 }
 
 TEST(CliTrain, OptionsReachTheRun) {
@@ -191,9 +191,10 @@ TEST(CliEvaluateAndRollout, WorkOnASavedRun) {
   const std::vector<std::string> lines = lines_of(read_text(csv));
   ASSERT_EQ(lines.size(), 1u + 2u * 2u * 50u);
   EXPECT_EQ(lines[0], "source,traj,t,x_0,x_1,energy,learned_h");
-  EXPECT_EQ(lines[1].rfind("true,0,0,", 0), 0u) << lines[1];
-  EXPECT_EQ(lines[101].rfind("hnn,0,0,", 0), 0u) << lines[101];
-  EXPECT_NE(lines[150].find(",5,"), std::string::npos) << lines[150];  // t_end of trajectory 0
+  EXPECT_EQ(lines[1].rfind("true,0,0,", 0), 0u) << lines[1];  // per trajectory: truth, model
+  EXPECT_EQ(lines[51].rfind("hnn,0,0,", 0), 0u) << lines[51];
+  EXPECT_NE(lines[100].find(",5,"), std::string::npos) << lines[100];  // t_end of trajectory 0
+  EXPECT_NE(r.out.find("hnn rollout: 2 trajectories, rk4 -> "), std::string::npos) << r.out;
 }
 
 TEST(CliReproduce, WritesTable1WithThePapersValues) {

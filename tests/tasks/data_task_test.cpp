@@ -114,10 +114,10 @@ TEST(DataTask, TrainsOnACsvAndEvaluatesOnHeldOutTrajectories) {
   EXPECT_TRUE(m["energy_mse"].is_number());
   EXPECT_EQ(m["state_names"], nlohmann::json({"q1", "q2", "p1", "p2"}));
   const std::vector<std::string> csv = read_lines(dir / "hnn" / "rollout.csv");
-  EXPECT_EQ(csv[0],
-            "traj,t,true_0,true_1,true_2,true_3,pred_0,pred_1,pred_2,pred_3,true_energy,"
-            "pred_energy,learned_h");
-  EXPECT_EQ(csv.size(), 1u + 2 * 25);
+  EXPECT_EQ(csv[0], "source,traj,t,q1,q2,p1,p2,energy,learned_h");
+  EXPECT_EQ(csv.size(), 1u + 2 * 2 * 25);  // per held-out stretch the data's rows and the hnn's
+  EXPECT_EQ(csv[1].substr(0, 9), "data,0,0,");
+  EXPECT_EQ(csv[26].substr(0, 8), "hnn,0,0,");
   // A loaded run evaluates to the same numbers.
   const nlohmann::json again = evaluate_run(dir / "hnn", "", false);
   EXPECT_DOUBLE_EQ(again["test_loss"].get<double>(), m["test_loss"].get<double>());

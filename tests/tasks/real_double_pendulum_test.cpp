@@ -63,9 +63,23 @@ TEST(RealDoublePendulum, ShortLnnAndBaselineRunsLearnAndFollowTheMeasurements) {
   }
   // `hnn rollout` writes the measured paths beside the model's.
   const LoadedRun run = load_run(dir / "baseline");
-  const std::string csv = run.run->rollout_csv({.points = 11, .trajectories = 2});
-  EXPECT_NE(csv.find("\nmeasured,0,0,"), std::string::npos) << csv.substr(0, 200);
+  const RolloutOutput out = run.run->rollout({.points = 11, .trajectories = 2});
+  EXPECT_EQ(out.trajectories, 2);
+  const std::string& csv = out.csv;
+  EXPECT_NE(csv.find("\ndata,0,0,"), std::string::npos) << csv.substr(0, 200);
   EXPECT_NE(csv.find("\nbaseline,1,"), std::string::npos);
+  // Past the measured paths (1 s) the truth is unavailable, and the note says so; from a given
+  // state there is none at all.
+  const RolloutOutput longer = run.run->rollout({.t_end = 3, .points = 11, .trajectories = 1});
+  ASSERT_EQ(longer.notes.size(), 1u);
+  EXPECT_EQ(longer.notes[0],
+            "real-double-pendulum: the truth is unavailable past the data: the measured paths end "
+            "at t = 1 and the model's run to t = 3");
+  const RolloutOutput given =
+      run.run->rollout({.points = 3, .initial_states = Eigen::RowVector4d(0.1, 0.2, 0, 0)});
+  EXPECT_EQ(given.trajectories, 1);
+  EXPECT_EQ(given.csv.find("\ndata,"), std::string::npos);
+  ASSERT_EQ(given.notes.size(), 1u);
 }
 
 TEST(RealDoublePendulum, RefusesModelsThatNeedMomenta) {

@@ -84,32 +84,33 @@ void expect_loss_curve(const fs::path& path, int steps) {
 }
 
 std::string rollout_header(int dim) {
-  std::string h = "traj,t";
-  for (const char* which : {"true", "pred"}) {
-    for (int k = 0; k < dim; ++k) h += fmt::format(",{}_{}", which, k);
-  }
-  return h + ",true_energy,pred_energy,learned_h";
+  std::string h = "source,traj,t";
+  for (int k = 0; k < dim; ++k) h += fmt::format(",x_{}", k);
+  return h + ",energy,learned_h";
 }
 
-// rollout.csv: the documented header, 15 trajectories x points rows, times from 0 to t_end, the
-// true energy in every row, the learned H exactly when the model is an HNN.
-void expect_rollout_csv(const fs::path& path, const TaskShape& shape, bool has_h) {
+// rollout.csv: the documented header, per trajectory (15) a block of points rows of the truth
+// and one of the model, times from 0 to t_end, the true energy in every truth row, the learned H
+// exactly in the rows of an HNN's prediction.
+void expect_rollout_csv(const fs::path& path, const TaskShape& shape, const std::string& model) {
   const std::vector<std::string> lines = read_lines(path);
   ASSERT_FALSE(lines.empty());
   EXPECT_EQ(lines[0], rollout_header(shape.dim));
-  ASSERT_EQ(lines.size(), 1u + 15u * std::size_t(shape.rollout_points));
-  const std::size_t cells_per_row = 2 + 2 * std::size_t(shape.dim) + 3;
+  const auto points = std::size_t(shape.rollout_points);
+  ASSERT_EQ(lines.size(), 1u + 2 * 15u * points);
+  const std::size_t cells_per_row = 3 + std::size_t(shape.dim) + 2;
   for (std::size_t i = 1; i < lines.size(); ++i) {
     const std::vector<std::string> cells = split_csv(lines[i]);
     ASSERT_EQ(cells.size(), cells_per_row) << "line " << i << ": " << lines[i];
-    const std::size_t k = (i - 1) % std::size_t(shape.rollout_points);
-    ASSERT_EQ(std::stoi(cells[0]), int((i - 1) / std::size_t(shape.rollout_points))) << i;
-    const double t = std::stod(cells[1]);
-    EXPECT_NEAR(t, shape.t_end * double(k) / (shape.rollout_points - 1), 1e-6) << i;
-    EXPECT_FALSE(cells[2 + 2 * std::size_t(shape.dim)].empty()) << "true_energy, line " << i;
-    if (!has_h) {
-      EXPECT_TRUE(cells.back().empty()) << "learned_h of a baseline, line " << i;
-    } else if (!cells[2 + std::size_t(shape.dim)].empty()) {  // a prediction: its H too
+    const std::size_t block = (i - 1) / points, k = (i - 1) % points;
+    const bool truth = block % 2 == 0;
+    ASSERT_EQ(cells[0], truth ? "true" : model) << "line " << i;
+    ASSERT_EQ(std::stoi(cells[1]), int(block / 2)) << "line " << i;
+    EXPECT_NEAR(std::stod(cells[2]), shape.t_end * double(k) / double(points - 1), 1e-6) << i;
+    if (truth) EXPECT_FALSE(cells[3 + std::size_t(shape.dim)].empty()) << "energy, line " << i;
+    if (truth || model != "hnn") {
+      EXPECT_TRUE(cells.back().empty()) << "learned_h of the truth or a baseline, line " << i;
+    } else if (!cells[3].empty()) {  // a prediction: its H too
       EXPECT_FALSE(cells.back().empty()) << "learned_h, line " << i;
     }
   }
@@ -141,7 +142,7 @@ TEST_P(RunFolder, HoldsCompleteMetricsCurvesRolloutsAndLoadableParameters) {
   // Three bodies: the errors at early times, where chaos has not yet taken over.
   EXPECT_EQ(m.contains("state_mse_t1"), shape.task == "three-body");
   expect_loss_curve(dir / "loss_curve.csv", 10);
-  expect_rollout_csv(dir / "rollout.csv", shape, /*has_h=*/true);
+  expect_rollout_csv(dir / "rollout.csv", shape, "hnn");
 
   const LoadedRun run = load_run(dir.path());
   EXPECT_EQ(run.settings.task, shape.task);
@@ -168,7 +169,7 @@ TEST(RunFolderBaseline, HasNoLearnedHamiltonianButEverythingElse) {
   TempDir dir("run");
   const json m = run_training(testing::small_run("spring", "baseline", dir.path(), 10));
   expect_complete_metrics(m, "spring", "baseline", 0, 10, "double");
-  expect_rollout_csv(dir / "rollout.csv", kShapes[0], /*has_h=*/false);
+  expect_rollout_csv(dir / "rollout.csv", kShapes[0], "baseline");
   EXPECT_EQ(load_run(dir.path()).run->dynamics().name(), "baseline");
 }
 

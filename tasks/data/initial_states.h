@@ -1,0 +1,24 @@
+#pragma once
+// Initial states a user gives `hnn rollout`: `--state v0,v1,...` on the command line, or a CSV
+// file (`--states FILE`) whose header names the state's columns. Both are read against the
+// run's state columns (TaskRun::state_names: the data's own names for a data run, x_0..x_{d-1}
+// otherwise) into one state per row.
+
+#include <string>
+#include <vector>
+
+#include "physics/types.h"
+
+namespace hnn::tasks {
+
+/// One state per value "v0,v1,...": as many numbers as `names`, in their order. Throws Error
+/// naming the value, and the position and column of a bad number.
+physics::Batch states_from_values(const std::vector<std::string>& values,
+                                  const std::vector<std::string>& names);
+
+/// One state per data row of the CSV file `path`, whose header names each state column once,
+/// in any order, by its name in `names` or as x_0..x_{d-1}. Throws Error naming the file, and
+/// the line and column of a bad cell or the header's unknown or missing column.
+physics::Batch states_from_file(const std::string& path, const std::vector<std::string>& names);
+
+}  // namespace hnn::tasks
