@@ -1,16 +1,71 @@
-"""rollout.csv of `hnn train` and `hnn reproduce` (per test trajectory: time, true and predicted
-states, energies, the HNN's learned H), and the panels that Figures 2 and 3 share: the
-coordinate MSE against time and the total energy."""
+"""rollout.csv of `hnn train` and `hnn reproduce`, and the rollout_<integrator>.csv of `hnn
+rollout` (per test trajectory: time, true and predicted states, energies, the HNN's learned H),
+and the panels that Figures 2 and 3 share: the coordinate MSE against time and the total
+energy."""
+
+import csv
 
 import numpy as np
 
-from .common import COLORS, LABELS, MODELS, PlotError, is_number, note, read_csv
+from .common import COLORS, LABELS, MODELS, PlotError, is_number, note, read_csv, to_float
+
+COMPARISON = ["traj", "t", "true_energy", "pred_energy", "learned_h"]
+TRUTH_SOURCES = ("true", "data")  # the older `hnn rollout` layout's sources of the truth
+
+
+def paths_as_comparison(path):
+    """The older layout of `hnn rollout` (source,traj,t,<state>,energy,learned_h: the truth's
+    rows ("true", or "data" for measured stretches), then the model's) as the columns of the
+    comparison layout (traj,t,true_0..,pred_0..,true_energy,pred_energy,learned_h). Only when
+    both are sampled at the same times; else an error naming the trajectory."""
+    with open(path, newline="", encoding="utf-8") as f:
+        rows = [r for r in csv.reader(f) if r]
+    header, d = [h.strip() for h in rows[0]], len(rows[0]) - 5
+    if d < 1 or header[:3] != ["source", "traj", "t"] or header[-2:] != ["energy", "learned_h"]:
+        raise PlotError(f"{path}: header is not source,traj,t,<state>,energy,learned_h")
+    parts = {}
+    for line, row in enumerate(rows[1:], start=2):
+        if len(row) != len(header):
+            raise PlotError(f"{path}:{line}: {len(row)} cells, header has {len(header)}")
+        side = "true" if row[0] in TRUTH_SOURCES else "pred"
+        values = [to_float(c, path, line, h) for c, h in zip(row[1:], header[1:])]
+        parts.setdefault((values[0], side), []).append(values)
+    cols = {name: [] for name in COMPARISON[:2] + [f"{w}_{i}" for w in ("true", "pred")
+                                                   for i in range(d)] + COMPARISON[2:]}
+    for traj in sorted({k for k, _ in parts}):
+        true, pred = (np.array(parts.get((traj, s), [])) for s in ("true", "pred"))
+        if len(true) == 0 or len(pred) == 0 or true.shape != pred.shape or not np.allclose(
+                true[:, 1], pred[:, 1]):
+            raise PlotError(f"{path}: trajectory {traj:g}: the truth and the model are not"
+                            " sampled at the same times, which this older layout of `hnn"
+                            " rollout` needs to be drawn")
+        for i in range(d):
+            cols[f"true_{i}"] += list(true[:, 2 + i])
+            cols[f"pred_{i}"] += list(pred[:, 2 + i])
+        cols["traj"] += list(true[:, 0])
+        cols["t"] += list(true[:, 1])
+        cols["true_energy"] += list(true[:, 2 + d])
+        cols["pred_energy"] += list(pred[:, 2 + d])
+        cols["learned_h"] += list(pred[:, 3 + d])
+    if not cols["t"]:
+        raise PlotError(f"{path}: no data rows")
+    return {name: np.array(values, dtype=float) for name, values in cols.items()}
+
+
+def read_rollout_columns(path):
+    """The columns of a rollout CSV in the comparison layout, from either layout."""
+    with open(path, newline="", encoding="utf-8", errors="replace") as f:
+        first = f.readline()
+    if first.startswith("source,"):
+        return paths_as_comparison(path)
+    return read_csv(path, COMPARISON)
+
 
 class Rollout:
     """rollout.csv of one model: per-trajectory time, true and predicted states and energies."""
 
     def __init__(self, path):
-        cols = read_csv(path, ["traj", "t", "true_energy", "pred_energy", "learned_h"])
+        cols = read_rollout_columns(path)
         d = sum(1 for h in cols if h.startswith("true_") and h != "true_energy")
         state = [f"true_{i}" for i in range(d)] + [f"pred_{i}" for i in range(d)]
         missing = [c for c in state if c not in cols]
