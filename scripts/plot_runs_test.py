@@ -93,15 +93,17 @@ class RunChartsTest(unittest.TestCase):
         self.assertIn("Learned H, as learned (defined only up to a constant;", contour)
         self.assertNotIn("True energy", contour)
 
-    def test_an_older_rollout_file_sampled_apart_is_an_error_naming_the_trajectory(self):
+    def test_an_older_rollout_file_whose_truth_ends_early_is_drawn_up_to_its_end(self):
         t, trajs = spring_rollouts("hnn")
-        path = os.path.join(self.root, "apart.csv")
-        write_paths(path, t, trajs, ["q", "p"], "hnn", t_truth=t + 0.5)
-        run = self.plot("--rollouts", path, "--out", os.path.join(self.root, "apart_out"))
-        self.assertEqual(run.returncode, 1, run.stderr)
-        self.assertIn(f"{path}: trajectory 0: the truth and the model are not sampled at the"
-                      " same times", run.stderr)
-        self.assertFalse(os.path.exists(os.path.join(self.root, "apart_out")))
+        path = os.path.join(self.root, "short.csv")
+        write_paths(path, t, trajs, ["q", "p"], "hnn", truth_rows=40)
+        out = os.path.join(self.root, "short_out")
+        run = self.plot("--rollouts", path, "--out", out)
+        self.assertEqual(run.returncode, 0, run.stderr)
+        self.assertIn(f"{path}: the truth of 3 trajectories is sampled at other times than the"
+                      " model's: drawn interpolated between its samples, and not past its end",
+                      run.stderr)
+        self.assert_drawn(out, ["short_hnn", "h_contour_short_hnn"], run.stdout)
 
     def test_runs_and_rollouts_need_out_and_not_both(self):
         for args in (["--runs", self.hnn], ["--rollouts", "x.csv", "--runs", self.hnn,

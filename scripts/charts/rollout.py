@@ -13,11 +13,23 @@ COMPARISON = ["traj", "t", "true_energy", "pred_energy", "learned_h"]
 TRUTH_SOURCES = ("true", "data")  # the older `hnn rollout` layout's sources of the truth
 
 
+def truth_at(true, t):
+    """The truth's rows (traj, t, states..., energy, learned_h) at the times t: linear
+    interpolation between its samples, NaN outside their span (a measured stretch may end before
+    the model's rollout does)."""
+    out = np.full((len(t), true.shape[1]), np.nan)
+    inside = (t >= true[0, 1] - 1e-9 * abs(true[-1, 1])) & (t <= true[-1, 1] * (1 + 1e-12))
+    for c in range(2, true.shape[1]):
+        out[inside, c] = np.interp(t[inside], true[:, 1], true[:, c])
+    return out
+
+
 def paths_as_comparison(path):
     """The older layout of `hnn rollout` (source,traj,t,<state>,energy,learned_h: the truth's
     rows ("true", or "data" for measured stretches), then the model's) as the columns of the
-    comparison layout (traj,t,true_0..,pred_0..,true_energy,pred_energy,learned_h). Only when
-    both are sampled at the same times; else an error naming the trajectory."""
+    comparison layout (traj,t,true_0..,pred_0..,true_energy,pred_energy,learned_h), at the
+    model's times: the truth interpolated linearly between its samples when they differ, and
+    empty past its end (with a note)."""
     with open(path, newline="", encoding="utf-8") as f:
         rows = [r for r in csv.reader(f) if r]
     header, d = [h.strip() for h in rows[0]], len(rows[0]) - 5
@@ -32,23 +44,24 @@ def paths_as_comparison(path):
         parts.setdefault((values[0], side), []).append(values)
     cols = {name: [] for name in COMPARISON[:2] + [f"{w}_{i}" for w in ("true", "pred")
                                                    for i in range(d)] + COMPARISON[2:]}
+    moved = 0
     for traj in sorted({k for k, _ in parts}):
         true, pred = (np.array(parts.get((traj, s), [])) for s in ("true", "pred"))
-        if len(true) == 0 or len(pred) == 0 or true.shape != pred.shape or not np.allclose(
-                true[:, 1], pred[:, 1]):
-            raise PlotError(f"{path}: trajectory {traj:g}: the truth and the model are not"
-                            " sampled at the same times, which this older layout of `hnn"
-                            " rollout` needs to be drawn")
+        if len(true) < 2 or len(pred) == 0:
+            raise PlotError(f"{path}: trajectory {traj:g} lacks the truth's rows or the model's")
+        if true.shape != pred.shape or not np.allclose(true[:, 1], pred[:, 1]):
+            true, moved = truth_at(true, pred[:, 1]), moved + 1
         for i in range(d):
             cols[f"true_{i}"] += list(true[:, 2 + i])
             cols[f"pred_{i}"] += list(pred[:, 2 + i])
-        cols["traj"] += list(true[:, 0])
-        cols["t"] += list(true[:, 1])
+        cols["traj"] += list(pred[:, 0])
+        cols["t"] += list(pred[:, 1])
         cols["true_energy"] += list(true[:, 2 + d])
         cols["pred_energy"] += list(pred[:, 2 + d])
         cols["learned_h"] += list(pred[:, 3 + d])
-    if not cols["t"]:
-        raise PlotError(f"{path}: no data rows")
+    if moved:
+        note(f"{path}: the truth of {moved} trajectories is sampled at other times than the"
+             " model's: drawn interpolated between its samples, and not past its end")
     return {name: np.array(values, dtype=float) for name, values in cols.items()}
 
 
