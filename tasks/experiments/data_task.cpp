@@ -129,7 +129,11 @@ class DataRun : public FieldModelRun {
     m["units"] = p_.units.to_json();
     m["state_names"] = p_.measured.state_names;
     m["data"] = describe(p_.measured);
-    if (folder) folder->write_text("rollout.csv", held_out_csv(held));
+    if (folder) {
+      folder->write_text("rollout.csv", held_out_csv(held));
+      // Said once the run has gone through: an error before it stays the one line on stderr.
+      fmt::print(stderr, "hnn: data: {}\n", derivatives_source(p_.measured));
+    }
     return m;
   }
 
