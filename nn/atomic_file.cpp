@@ -33,12 +33,51 @@ int create_temporary(const fs::path& path, fs::path& temp) {
   }
 }
 
+// The first of `p` and its ancestors that is a regular file (where a folder should be), or "".
+fs::path blocking_file(fs::path p) {
+  std::error_code ec;
+  for (; !p.empty(); p = p.parent_path()) {
+    if (fs::is_regular_file(p, ec)) return p;
+    if (p == p.parent_path()) break;
+  }
+  return {};
+}
+
+// What stopped the temporary file's creation, said of the folder the user named rather than of
+// the temporary file: a missing folder, or a file where a folder should be.
+std::string creation_step(const fs::path& path, int error) {
+  const fs::path dir = path.has_parent_path() ? path.parent_path() : fs::path(".");
+  std::error_code ec;
+  if (const fs::path file = blocking_file(dir); error == ENOTDIR && !file.empty())
+    return fmt::format("'{}' is a file, not a folder", file.string());
+  if (error == ENOENT && !fs::exists(dir, ec))
+    return fmt::format("its folder '{}' does not exist", dir.string());
+  return "creating a temporary file in its folder";
+}
+
 }  // namespace
+
+std::string filesystem_error_line(const fs::filesystem_error& e) {
+  // libstdc++'s what() is "filesystem error: <operation>: <reason> [path1] [path2]".
+  std::string operation = e.what();
+  const std::string prefix = "filesystem error: ", reason = ": " + e.code().message();
+  if (operation.starts_with(prefix)) operation.erase(0, prefix.size());
+  operation = operation.substr(0, operation.find(reason));
+  const fs::path file =
+      e.code() == std::errc::not_a_directory ? blocking_file(e.path1()) : fs::path();
+  return fmt::format("'{}': {} ({})", e.path1().string(),
+                     file.empty() ? e.code().message()
+                                  : fmt::format("'{}' is a file, not a folder", file.string()),
+                     operation);
+}
 
 void write_file_atomic(const fs::path& path, std::string_view content) {
   fs::path temp;
   const int fd = create_temporary(path, temp);
-  if (fd < 0) throw FileWriteError(last_error(), path, "creating a temporary file");
+  if (fd < 0) {
+    const std::error_code code = last_error();
+    throw FileWriteError(code, path, creation_step(path, code.value()));
+  }
   const auto fail = [&](std::error_code code, const char* step, bool open) {
     if (open) ::close(fd);
     ::unlink(temp.c_str());

@@ -11,14 +11,15 @@
 namespace hnn::nn {
 
 /// A file that could not be written. what() is "cannot write '<path>' (<step>): <system
-/// message>", e.g. "cannot write 'out/x.csv' (creating a temporary file): No such file or
+/// message>", e.g. "cannot write 'out/x.csv' (its folder 'out' does not exist): No such file or
 /// directory".
 class FileWriteError : public std::system_error {
  public:
   FileWriteError(std::error_code code, const std::filesystem::path& path, std::string step);
   const std::filesystem::path& path() const { return path_; }
-  /// What failed: "creating a temporary file", "writing", "flushing to disk", "closing" or
-  /// "renaming into place".
+  /// What failed: "its folder 'D' does not exist", "'F' is a file, not a folder", "creating a
+  /// temporary file in its folder", "writing", "flushing to disk", "closing" or "renaming into
+  /// place".
   const std::string& step() const { return step_; }
 
  private:
@@ -32,5 +33,9 @@ class FileWriteError : public std::system_error {
 /// folder fsync'ed so that the rename itself is durable (best effort: some file systems refuse).
 /// Throws FileWriteError on failure and then leaves no temporary file behind.
 void write_file_atomic(const std::filesystem::path& path, std::string_view content);
+
+/// A std::filesystem error as one line naming the path and why, e.g. "'afile/sub': 'afile' is a
+/// file, not a folder (cannot create directories)", for the programs' error line.
+std::string filesystem_error_line(const std::filesystem::filesystem_error& e);
 
 }  // namespace hnn::nn

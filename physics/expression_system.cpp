@@ -88,8 +88,11 @@ GiNaC::ex parse_hamiltonian(const std::string& text, const std::vector<GiNaC::ex
   try {
     h = reader(text);
   } catch (const std::exception& e) {
+    // Python's power operator is the commonest slip: GiNaC reads only ^.
+    const char* hint =
+        text.find("**") != std::string::npos ? " (write powers with ^: q^4, not q**4)" : "";
     throw std::invalid_argument(
-        fmt::format("hamiltonian '{}' does not parse: {}", text, parse_reason(e.what())));
+        fmt::format("hamiltonian '{}' does not parse: {}{}", text, parse_reason(e.what()), hint));
   }
   std::vector<std::string> unknown;
   for (const auto& [name, value] : reader.get_syms()) {

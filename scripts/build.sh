@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Configures and builds hnn (Release, this CPU's vector extensions) in build/. Safe to re-run.
 # Extra arguments go to cmake's configure step, e.g. -DHNN_NATIVE=OFF.
+source "$(dirname "$0")/help.sh"
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh

@@ -4,6 +4,7 @@
 # Usage: scripts/charts.sh [--quick]   (--quick: a smoke run with coarse sweeps, minutes -> seconds)
 # Environment: HNN_CHARTS_OUT (default docs/charts), HNN_CHARTS_BUILD (default build-charts),
 # HNN_CHARTS_THREADS (engine threads, default 1: steadier timings on a shared machine).
+source "$(dirname "$0")/help.sh"
 set -euo pipefail
 cd "$(dirname "$0")/.."
 out=${HNN_CHARTS_OUT:-docs/charts}

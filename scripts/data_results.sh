@@ -6,6 +6,7 @@
 #   build/apps/hnn sweep sweeps/data_results.yaml --out results/data/sweep
 #   /usr/bin/python3 scripts/plot_study.py data_results results/data/sweep
 # Usage: scripts/data_results.sh   (seconds)
+source "$(dirname "$0")/help.sh"
 set -euo pipefail
 cd "$(dirname "$0")/.."
 out=results/data

@@ -9,6 +9,7 @@
 # fuzz/regressions/<name>/ (both are replayed by tests/reliability/fuzz_corpus_test.cpp) and
 # makes the script fail. Usage: scripts/fuzz.sh [name...]   (names: lipson params train_state
 # table)
+source "$(dirname "$0")/help.sh"
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=${FUZZ_SECONDS:-60}

@@ -38,6 +38,23 @@ def write_rollout(path, t, trajs, model, truth="true", names=None):
                     f.write(",".join(cells) + "\n")
 
 
+def write_paths(path, t, trajs, names, model, truth_rows=None):
+    """The older layout of `hnn rollout`: source,traj,t,<names>,energy,learned_h, the truth's
+    rows ("true") then the model's, of write_rollout's trajs; truth_rows: the truth's first rows
+    only (a measured stretch that ends before the rollout)."""
+    with open(path, "w") as f:
+        f.write(",".join(["source", "traj", "t", *names, "energy", "learned_h"]) + "\n")
+        for side in ("true", model):
+            for k, (true, pred, e_true, e_pred, h) in enumerate(trajs):
+                states, energy = (true, e_true) if side == "true" else (pred, e_pred)
+                rows = truth_rows if side == "true" and truth_rows else len(t)
+                for i, ti in enumerate(t[:rows]):
+                    cells = [side, str(k), f"{ti:.6g}"] + [f"{v:.9g}" for v in states[i]]
+                    cells.append("" if energy is None else f"{energy[i]:.9g}")
+                    cells.append("" if h is None or side == "true" else f"{h[i]:.9g}")
+                    f.write(",".join(cells) + "\n")
+
+
 def write_loss_curve(path, final_train, final_test, steps):
     step = np.arange(0, steps + 1, steps // 40)
     decay = np.exp(-step / (steps / 6))

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The main job: builds hnn and reproduces the paper's Table 1 with charts into results/.
 # Arguments go to `hnn reproduce` (e.g. --tasks spring,two-body --seeds 3). Safe to re-run.
+source "$(dirname "$0")/help.sh"
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/build.sh

@@ -8,6 +8,7 @@
 # four shards, <module>.shard0..3 (tests/CMakeLists.txt).
 # Any finding fails the test that triggers it. Safe to re-run; extra arguments go to ctest
 # (e.g. -R reliability). HNN_JOBS sets the parallelism (default: the CPU count).
+source "$(dirname "$0")/help.sh"
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh

@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
 # Installs the Debian packages hnn needs, only those missing. Safe to re-run.
+source "$(dirname "$0")/help.sh"
 set -euo pipefail
 
 packages=(

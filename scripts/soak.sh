@@ -7,6 +7,7 @@
 # last tenth. Memory must stay flat and the step time must not creep.
 #   scripts/soak.sh [extra hnn train options, e.g. --hidden 64 64]
 # Environment: STEPS, INTERVAL, OUT (run folder, default build/soak), HNN (the program).
+source "$(dirname "$0")/help.sh"
 set -euo pipefail
 cd "$(dirname "$0")/.."
 steps=${STEPS:-100000}

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The test command: installs what is missing, builds, runs the whole test suite, then installs
 # the package and builds the examples/ projects against it. Safe to re-run.
+source "$(dirname "$0")/help.sh"
 set -euo pipefail
 cd "$(dirname "$0")/.."
 root=$(pwd)

@@ -5,8 +5,10 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <filesystem>
 
 #include "apps/hnn/commands/commands.h"
+#include "nn/atomic_file.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"hnn: Hamiltonian Neural Networks (Greydanus et al. 2019) in C++"};
@@ -29,6 +31,9 @@ int main(int argc, char** argv) {
     std::string message = e.what();
     std::replace(message.begin(), message.end(), '\n', ' ');
     fmt::print(stderr, "hnn: error: {} (see --help)\n", message);
+    return 1;
+  } catch (const std::filesystem::filesystem_error& e) {  // e.g. --out under a regular file
+    fmt::print(stderr, "hnn: error: {}\n", hnn::nn::filesystem_error_line(e));
     return 1;
   } catch (const std::exception& e) {
     fmt::print(stderr, "hnn: error: {}\n", e.what());

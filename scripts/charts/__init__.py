@@ -2,8 +2,11 @@
 chart as PNG and SVG, written atomically).
 
 Commands (thin entry points in scripts/, each with --help):
-  scripts/plot.py RESULTS_DIR | --runs RUN... --out DIR   paper.py: Figures 2 and 3, training
-                                                          curves, the Table 1 chart
+  scripts/plot.py RESULTS_DIR | --runs RUN... --out DIR | --rollouts CSV... --out DIR
+                                                          paper.py: Figures 2 and 3, training
+                                                          curves, the Table 1 chart; runs.py:
+                                                          the charts of run folders and of
+                                                          rollout files
   scripts/plot_pixel.py RESULTS_DIR                       pixel.py: Figures 4, C1, 5, reversibility
   scripts/plot_speed_accuracy.py DIR                      speed_accuracy.py: bench/accuracy's charts
   scripts/plot_study.py STUDY SWEEP_DIR [--out DIR]       studies.py: a study of sweeps/ from
@@ -11,7 +14,10 @@ Commands (thin entry points in scripts/, each with --help):
 
 Modules:
   common           backend and style, errors and notes, readers, names and colours, atomic writer
-  rollout          rollout.csv, and the coordinate-MSE and energy panels of Figures 2 and 3
+  rollout          rollout.csv (and hnn rollout's files, either layout), and the coordinate-MSE
+                   and energy panels of Figures 2 and 3
+  runs             run folders (--runs) and rollout files (--rollouts): which charts each gets
+  h_contour        the learned H beside the true one over the phase plane (one degree of freedom)
   fig2, fig3       the paper's Figures 2 (phase space, MSE, conserved H, energy) and 3 (orbits)
   training_curves  train and test loss against the step
   table1           table1.json, and ours against the paper's Table 1

@@ -52,8 +52,13 @@ def plot_learned_h_panel(ax, rolls, truth, drift=False, spread=None):
             if spread:
                 text += f"\n= {100 * change / spread:.2g}% of H's spread on the training states"
         else:
-            ax.plot(t, h, color=COLORS["hnn"], label=LABELS["hnn"])
-            set_limits(ax.set_ylim, clamp_limits(h, h, min_span=energy_scale(truth)))
+            shift = learned_h_shift(h, truth)
+            ax.plot(t, h + shift, color=COLORS["hnn"], label=LABELS["hnn"])
+            set_limits(ax.set_ylim, clamp_limits(h + shift, h + shift,
+                                                 min_span=energy_scale(truth)))
+            if shift:
+                text = (f"{text}\nH is defined only up to a constant: drawn + {shift:.4g},"
+                        " to equal\nthe true energy at the rollout's start")
         ax.text(0.03, 0.04, text, transform=ax.transAxes)
         ax.legend(loc="upper right")
     else:
@@ -65,8 +70,17 @@ def plot_learned_h_panel(ax, rolls, truth, drift=False, spread=None):
         if drift:
             ax.set(xticks=[], yticks=[])
     ax.set(title="(c) HNN-conserved quantity", xlabel=xlabel,
-           ylabel=r"learned $H_\theta(t) - H_\theta(t_0)$ along the HNN rollout" if drift
-           else r"learned $H_\theta$ along the HNN rollout")
+           ylabel=r"learned $H_\theta(t) - H_\theta(t_0)$ along the HNN rollout" "\n"
+           "(H is defined only up to a constant)" if drift
+           else r"learned $H_\theta$ + constant, along the HNN rollout")
+
+
+def learned_h_shift(h, truth):
+    """The constant that makes the learned H equal the true energy at the shown rollout's first
+    state (where the rollout starts from the true state): H is defined only up to a constant.
+    0 without a true energy there."""
+    e0 = truth["true_energy"][0] if len(truth["true_energy"]) else np.nan
+    return float(e0 - h[0]) if np.isfinite(e0) and np.isfinite(h[0]) else 0.0
 
 
 def phase_axes(d, metrics):
@@ -99,13 +113,14 @@ def run_labels(runs):
     return labels
 
 
-def draw_fig2(results, task, runs, rolls, truth, title=None):
+def draw_fig2(results, task, runs, rolls, truth, title=None, stem=None):
     """Paper Figure 2 row: (a) phase space, (b) coordinate MSE, (c) HNN-conserved quantity,
     (d) total energy, all for one test trajectory (the rollouts' `show`, 0 unless set) except
     (b), which covers all rollouts. A state of n > 1 degrees of freedom shows q_1 against p_1 in
     (a). Without a true energy (runs of data with no known Hamiltonian) (c) is the drift of the
     learned H and there is no (d). The data task's (b) compares the positions alone, as its
-    metrics.json's coordinate_mse does."""
+    metrics.json's coordinate_mse does. The files are <stem> (default fig2_<task>).png and
+    .svg."""
     metrics = next((runs[m]["metrics"] for m in MODELS if runs.get(m) and runs[m]["metrics"]),
                    {})
     coords, names, positions = phase_axes(truth["true"].shape[1], metrics)
@@ -135,4 +150,4 @@ def draw_fig2(results, task, runs, rolls, truth, title=None):
         which += f" (the longest of {len(roll.trajs)})"
     fig.suptitle(f"{title or TITLES.get(task, task)}: {which}, t = {t[0]:g}..{t[-1]:g}"
                  f"{energy_summary(runs)}")
-    return save(fig, results, f"fig2_{task}")
+    return save(fig, results, stem or f"fig2_{task}")

@@ -1,10 +1,26 @@
-"""rollout.csv of `hnn train` and `hnn reproduce` (per test trajectory: the truth's and the
-model's states and energies, the HNN's learned H), and the panels that Figures 2 and 3 share:
-the coordinate MSE against time and the total energy."""
+"""rollout.csv of `hnn train` and `hnn reproduce`, and the rollout_<integrator>.csv of `hnn
+rollout` (per test trajectory: time, true and predicted states, energies, the HNN's learned H),
+and the panels that Figures 2 and 3 share: the coordinate MSE against time and the total
+energy."""
+
 
 import numpy as np
 
 from .common import COLORS, LABELS, MODELS, PlotError, is_number, note, read_csv
+
+def truth_at(truth, t):
+    """The truth's columns (a dict of arrays over its own times) at the times t: linear
+    interpolation between its samples, NaN outside their span (a measured stretch may end before
+    the model's rollout does)."""
+    inside = (t >= truth["t"][0] - 1e-9 * abs(truth["t"][-1])) & \
+        (t <= truth["t"][-1] * (1 + 1e-12))
+    out = {"t": t}
+    for name, values in truth.items():
+        if name != "t":
+            out[name] = np.full(len(t), np.nan)
+            out[name][inside] = np.interp(t[inside], truth["t"], values)
+    return out
+
 
 # rollout.csv's columns besides the state's (tasks/report/rollout_csv.h), and the sources that
 # are the truth: the true system integrated, or measured data.
@@ -33,17 +49,23 @@ class Rollout:
         self.path, self.d, self.names, self.model = path, len(names), names, models[0]
         self.show = 0  # the trajectory of the single-trajectory panels
         self.trajs = []
+        moved = 0
         for k in np.unique(cols["traj"]):
             truth, pred = (self._rows(cols, source, k) for source in (truths[0], models[0]))
+            if len(truth["t"]) < 2 or len(pred["t"]) == 0:
+                raise PlotError(f"{path}: trajectory {k:g} lacks the {truths[0]} rows or the"
+                                f" {models[0]} rows")
             if len(truth["t"]) != len(pred["t"]) or not np.allclose(truth["t"], pred["t"]):
-                raise PlotError(f"{path}: trajectory {k:g}: the {truths[0]} and {models[0]}"
-                                " rows are not at the same times")
+                truth, moved = truth_at(truth, pred["t"]), moved + 1
             self.trajs.append({"t": truth["t"],
                                "true": np.stack([truth[n] for n in names], axis=1),
                                "pred": np.stack([pred[n] for n in names], axis=1),
                                "true_energy": truth["energy"],
                                "pred_energy": pred["energy"],
                                "learned_h": pred["learned_h"]})
+        if moved:
+            note(f"{path}: the truth of {moved} trajectories is sampled at other times than the"
+                 " model's: drawn interpolated between its samples, and not past its end")
 
     @staticmethod
     def _rows(cols, source, traj):

@@ -9,8 +9,9 @@ import numpy as np
 from .common import COLORS, LABELS, MODELS, TITLES, note, save
 from .rollout import log_y_if_positive
 
-def draw_training_curves(results, all_runs):
-    """One panel per task: train (solid) and test (dashed) loss vs step, baseline and HNN."""
+def draw_training_curves(results, all_runs, title=None):
+    """One panel per task: train (solid) and test (dashed) loss vs step, baseline and HNN.
+    title: the panel's title instead of the task's (run folders of the data task)."""
     tasks = [t for t, runs in all_runs.items()
              if any(runs.get(m) and runs[m]["loss"] is not None for m in MODELS)]
     if not tasks:
@@ -34,7 +35,7 @@ def draw_training_curves(results, all_runs):
                 curves.append(y)
         log_y_if_positive(ax, *curves)
         ylabel = "loss: ae + cc + 0.1 hnn" if task == "pixel-pendulum" else "loss: MSE of dx/dt"
-        ax.set(title=TITLES.get(task, task), xlabel="training step", ylabel=ylabel)
+        ax.set(title=title or TITLES.get(task, task), xlabel="training step", ylabel=ylabel)
         ax.legend()
     for ax in list(axes.flat)[len(tasks):]:
         ax.set_visible(False)

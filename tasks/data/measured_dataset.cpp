@@ -114,6 +114,9 @@ MeasuredData split_trajectories(const MeasuredTrajectories& m, const SplitChoice
   out.coordinates = m.coordinates;
   out.velocities = m.velocities;
   out.derivatives_given = m.derivatives_given;
+  out.derivatives_by_name = m.derivatives_by_name;
+  out.derivative_names = m.derivative_names;
+  out.derivatives_note = m.derivatives_note;
   out.trajectories = int(m.trajectory_ids.size());
   out.test_trajectories = distinct_trajectories(parts.test);
   out.gaps = m.gaps;
@@ -137,6 +140,8 @@ std::string describe(const MeasuredData& d) {
                   d.velocities ? " (velocities taken as momenta: unit masses assumed)" : "");
   text += d.derivatives_given ? "dx/dt from the file's derivative columns"
                               : "dx/dt by finite differences within each trajectory";
+  if (d.derivatives_by_name)
+    text += fmt::format(" ({}, found by name)", fmt::join(d.derivative_names, ", "));
   if (d.gaps > 0) text += fmt::format(", cut at {} gap{} in time", d.gaps, d.gaps == 1 ? "" : "s");
   if (d.dropped_rows > 0) {
     text += fmt::format(" ({} rows between gaps, in stretches under 3 points, left out)",
@@ -147,6 +152,23 @@ std::string describe(const MeasuredData& d) {
                   d.split == SplitBy::kTrajectories ? "trajectories" : "time",
                   d.data.train_x.rows(), d.data.test_x.rows(), d.test_trajectories, d.trajectories);
   return text;
+}
+
+std::string derivatives_source(const MeasuredData& d) {
+  if (d.derivatives_by_name) {
+    return fmt::format(
+        "{}: dx/dt from the columns {}, found by name (--derivatives names others; "
+        "--derivatives none takes finite differences)",
+        d.source, fmt::join(d.derivative_names, ", "));
+  }
+  if (d.derivatives_given)
+    return fmt::format("{}: dx/dt from the columns {}", d.source,
+                       fmt::join(d.derivative_names, ", "));
+  return fmt::format(
+      "{}: dx/dt by finite differences within each trajectory ({})", d.source,
+      d.derivatives_note.empty()
+          ? "no derivative columns such as d" + d.state_names[0] + "/dt: --derivatives names them"
+          : d.derivatives_note);
 }
 
 }  // namespace hnn::tasks

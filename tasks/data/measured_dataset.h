@@ -47,9 +47,12 @@ struct MeasuredData {
   std::string source;                    ///< the file
   std::vector<std::string> state_names;  ///< coordinates, then momenta (or velocities)
   Eigen::Index coordinates = 0;
-  bool velocities = false;         ///< the momenta are velocities: unit masses assumed
-  bool derivatives_given = false;  ///< else dx/dt by finite differences
-  SplitBy split = SplitBy::kTime;  ///< the split made (never kAuto)
+  bool velocities = false;                    ///< the momenta are velocities: unit masses assumed
+  bool derivatives_given = false;             ///< else dx/dt by finite differences
+  bool derivatives_by_name = false;           ///< the columns found by name, not chosen
+  std::vector<std::string> derivative_names;  ///< the columns of dx/dt, when given
+  std::string derivatives_note;               ///< some derivative columns found, not all
+  SplitBy split = SplitBy::kTime;             ///< the split made (never kAuto)
   int trajectories = 0, test_trajectories = 0, gaps = 0;
   Eigen::Index dropped_rows = 0;
 };
@@ -73,5 +76,9 @@ MeasuredData load_measured_data(const std::string& path, const MeasuredDataOptio
 /// they are velocities (unit masses assumed), where dx/dt came from, gaps and dropped rows,
 /// the split.
 std::string describe(const MeasuredData& data);
+
+/// Where dx/dt came from, in one line for stderr: the columns (and whether found by name), or
+/// finite differences and why.
+std::string derivatives_source(const MeasuredData& data);
 
 }  // namespace hnn::tasks

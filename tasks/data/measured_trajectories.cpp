@@ -95,17 +95,66 @@ void check_distinct(const Table& table, const Columns& c) {
   for (Eigen::Index j : c.derivatives) claim(j, "a derivative");
 }
 
-Columns resolve_columns(const Table& table, const ColumnChoice& choice) {
+// The names a derivative column of `name` may have: d<name>/dt (what `hnn simulate` writes),
+// d<name>dt, d<name>_dt, <name>_dot, and in an .npz d<name> (as dx beside x); an npz array's
+// column "x[1]" looks for "dx/dt[1]", ... "dx[1]".
+std::vector<std::string> derivative_names(const Table& table, const std::string& name) {
+  const std::size_t bracket = name.find('[');
+  const bool part = table.format == TableFormat::kNpz && bracket != std::string::npos;
+  const std::string base = part ? name.substr(0, bracket) : name;
+  const std::string index = part ? name.substr(bracket) : "";
+  std::vector<std::string> out = {"d" + base + "/dt", "d" + base + "dt", "d" + base + "_dt",
+                                  base + "_dot"};
+  if (table.format == TableFormat::kNpz) out.push_back("d" + base);
+  for (std::string& candidate : out) candidate += index;
+  return out;
+}
+
+// Derivative columns found by name for every state column, or none (with what was missing in
+// `note`): a column already chosen for another part is not one.
+std::vector<Eigen::Index> find_derivatives(const Table& table, const Columns& c,
+                                           std::string& note) {
+  std::vector<Eigen::Index> state = c.coords, found;
+  state.insert(state.end(), c.momenta.begin(), c.momenta.end());
+  std::vector<std::string> missing;
+  for (Eigen::Index j : state) {
+    Eigen::Index hit = -1;
+    for (const std::string& candidate : derivative_names(table, table.names[std::size_t(j)])) {
+      const Eigen::Index k = table.find(candidate);
+      const bool taken = k == c.time || k == c.trajectory ||
+                         std::find(state.begin(), state.end(), k) != state.end();
+      if (k >= 0 && !taken) {
+        hit = k;
+        break;
+      }
+    }
+    if (hit >= 0) found.push_back(hit);
+    if (hit < 0) missing.push_back(table.names[std::size_t(j)]);
+  }
+  if (missing.empty()) return found;
+  if (!found.empty()) {
+    note = fmt::format("derivative columns {} found, none for {}: --derivatives names them all",
+                       names_of(table, found), fmt::join(missing, ", "));
+  }
+  return {};
+}
+
+Columns resolve_columns(const Table& table, const ColumnChoice& choice, std::string& note) {
   Columns c;
-  c.time = choice.time.empty() ? first_present(table, {"t", "time"}) : table.column(choice.time);
+  c.time = choice.time.empty() ? first_present(table, {"t", "time", "times"})
+                               : table.column(choice.time);
   HNN_TASKS_CHECK(c.time >= 0,
-                  "{}: no time column (none is named t or time): give it by name or index "
+                  "{}: no time column (none is named t, time or times): give it by name or index "
                   "(columns: {})",
                   table.source, fmt::join(table.names, ", "));
   c.trajectory = choice.trajectory.empty() ? first_present(table, {"trajectory", "trial"})
                                            : table.column(choice.trajectory);
   resolve_state(table, choice, c);
-  c.derivatives = resolve(table, choice.derivatives);
+  const bool differences = choice.derivatives == std::vector<std::string>{"none"} &&
+                           table.find("none") < 0;  // --derivatives none
+  c.derivatives = differences ? std::vector<Eigen::Index>{} : resolve(table, choice.derivatives);
+  if (choice.derivatives.empty()) c.derivatives = find_derivatives(table, c, note);
+  if (differences) note = "--derivatives none";
   HNN_TASKS_CHECK(c.derivatives.empty() || c.derivatives.size() == 2 * c.coords.size(),
                   "{}: {} derivative columns ({}) for a state of {}: give dx/dt of every "
                   "coordinate, then of every {}",
@@ -204,14 +253,16 @@ MeasuredTrajectories select_trajectories(Table table, const ColumnChoice& choice
   HNN_TASKS_CHECK(
       choice.gap_factor == 0 || (choice.gap_factor > 1 && std::isfinite(choice.gap_factor)),
       "gap factor {} is neither 0 (never cut) nor a finite number > 1", choice.gap_factor);
-  const Columns c = resolve_columns(table, choice);
   MeasuredTrajectories out;
+  const Columns c = resolve_columns(table, choice, out.derivatives_note);
   out.coordinates = Eigen::Index(c.coords.size());
   for (const auto* part : {&c.coords, &c.momenta}) {
     for (Eigen::Index j : *part) out.state_names.push_back(table.names[std::size_t(j)]);
   }
   out.velocities = c.velocities;
   out.derivatives_given = !c.derivatives.empty();
+  for (Eigen::Index j : c.derivatives) out.derivative_names.push_back(table.names[std::size_t(j)]);
+  out.derivatives_by_name = out.derivatives_given && choice.derivatives.empty();
   out.time_name = table.names[std::size_t(c.time)];
   if (c.trajectory >= 0) out.trajectory_name = table.names[std::size_t(c.trajectory)];
   for (auto& [id, rows] : group_rows(table, c.trajectory)) {

@@ -23,10 +23,12 @@ struct ColumnChoice {
   /// Instead of momenta: dq/dt, taken as momenta with unit masses (the run should say so).
   /// Default in a Lipson file: the second half of the header's columns.
   std::vector<std::string> velocities = {};
-  /// dx/dt of every state column in state order (coordinates, then momenta); empty: finite
-  /// differences of the samples.
+  /// dx/dt of every state column in state order (coordinates, then momenta); empty: the
+  /// columns named d<x>/dt, d<x>dt, d<x>_dt or <x>_dot (an .npz also d<x>) when the file has
+  /// one for every state column, else finite differences of the samples; {"none"}: finite
+  /// differences.
   std::vector<std::string> derivatives = {};
-  std::string time = {};        ///< default: the column named "t", else "time"
+  std::string time = {};        ///< default: the column named "t", else "time", else "times"
   std::string trajectory = {};  ///< default: "trajectory", else "trial"; none: one trajectory
   /// A step longer than gap_factor times its trajectory's median step is a gap, where the
   /// trajectory is cut; 0 never cuts. Otherwise must be > 1.
@@ -43,15 +45,18 @@ struct Segment {
 };
 
 struct MeasuredTrajectories {
-  Table table;                             ///< what was read, for messages (Table::where)
-  std::vector<std::string> state_names;    ///< coordinates, then momenta (or velocities)
-  Eigen::Index coordinates = 0;            ///< n: the state is 2n wide
-  bool velocities = false;                 ///< p holds velocities: unit masses assumed
-  bool derivatives_given = false;          ///< dx/dt from columns, not differences
-  std::string time_name, trajectory_name;  ///< trajectory_name is "" when there is none
-  std::vector<double> trajectory_ids;      ///< in order of first appearance
-  std::vector<Segment> segments;           ///< by trajectory (that order), then time
-  int gaps = 0;                            ///< cuts made at gaps in time
+  Table table;                                ///< what was read, for messages (Table::where)
+  std::vector<std::string> state_names;       ///< coordinates, then momenta (or velocities)
+  Eigen::Index coordinates = 0;               ///< n: the state is 2n wide
+  bool velocities = false;                    ///< p holds velocities: unit masses assumed
+  bool derivatives_given = false;             ///< dx/dt from columns, not differences
+  bool derivatives_by_name = false;           ///< those columns found by their names
+  std::vector<std::string> derivative_names;  ///< the columns of dx/dt, when given
+  std::string derivatives_note;               ///< some derivative columns found but not all, or ""
+  std::string time_name, trajectory_name;     ///< trajectory_name is "" when there is none
+  std::vector<double> trajectory_ids;         ///< in order of first appearance
+  std::vector<Segment> segments;              ///< by trajectory (that order), then time
+  int gaps = 0;                               ///< cuts made at gaps in time
   /// Rows left out: stretches between gaps too short (< 3 points) to difference.
   Eigen::Index dropped_rows = 0;
 };

@@ -3,6 +3,7 @@
 // before xtensor allocates the data, so a corrupt shape cannot ask for terabytes.
 #include <zip.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <memory>
 #include <regex>
@@ -17,11 +18,7 @@ namespace hnn::tasks {
 
 namespace {
 
-// One array as columns: a 1-D array is one column.
-struct Array {
-  std::vector<std::size_t> shape;
-  Eigen::MatrixXd columns;
-};
+using Array = reader::NumpyArray;
 
 struct NpyHeader {
   std::string descr;
@@ -29,12 +26,6 @@ struct NpyHeader {
   std::vector<std::size_t> shape;
   std::size_t data_offset = 0;
 };
-
-std::string shape_text(const std::vector<std::size_t>& shape) {
-  std::string text;
-  for (std::size_t d : shape) text += (text.empty() ? "" : "x") + std::to_string(d);
-  return shape.empty() ? "a scalar" : text;
-}
 
 // The header's length field (little endian, 2 bytes in format 1.x, 4 in 2.x and 3.x), read here
 // only to check that the header and the data fit in the bytes present.
@@ -78,44 +69,61 @@ NpyHeader read_npy_header(const std::string& bytes, const std::string& where) {
   return header;
 }
 
+// The ranks an array may have: a .npy file's is a table (rows x columns); an .npz member is a
+// column, columns, or trajectories x times x components.
+struct Ranks {
+  std::size_t min, max;
+};
+constexpr Ranks kNpyRanks{2, 2}, kNpzRanks{1, 3};
+
 // Checks the dtype, rank and size before any allocation; returns the bytes per value.
 std::size_t check_npy_header(const NpyHeader& h, const std::string& bytes, const std::string& where,
-                             std::size_t min_rank) {
+                             Ranks ranks) {
   HNN_TASKS_CHECK(h.descr == "<f8" || h.descr == "<f4",
                   "{}: holds '{}' values; only float64 ('<f8') and float32 ('<f4') are read", where,
                   h.descr);
-  HNN_TASKS_CHECK(h.shape.size() >= min_rank && h.shape.size() <= 2,
-                  "{}: an array of shape {}; {} is needed", where, shape_text(h.shape),
-                  min_rank == 2 ? "a 2-D array (rows x columns)"
-                                : "a 1-D array (a column) or a 2-D array (columns)");
+  HNN_TASKS_CHECK(
+      h.shape.size() >= ranks.min && h.shape.size() <= ranks.max, "{}: an array of shape {}; {}{}",
+      where, reader::shape_text(h.shape),
+      ranks.max == 2 ? "a 2-D array (rows x columns) is needed"
+                     : "a 1-D, 2-D or 3-D array (trajectories x times x components) is needed",
+      h.shape.size() == 3 ? " (trajectories x times x components need their times: save them "
+                            "in an .npz, numpy.savez(FILE, x=x, t=t))"
+                          : "");
   const std::size_t word = h.descr == "<f8" ? 8 : 4;
   std::size_t expected = word;
   for (std::size_t d : h.shape) {
     HNN_TASKS_CHECK(d == 0 || expected <= bytes.size() / d,
                     "{}: truncated: shape {} needs more bytes than the file's {}", where,
-                    shape_text(h.shape), bytes.size());
+                    reader::shape_text(h.shape), bytes.size());
     expected *= d;
   }
   const std::size_t present = bytes.size() - h.data_offset;
   HNN_TASKS_CHECK(present == expected,
                   "{}: {}: shape {} of '{}' needs {} bytes of data, but {} follow the header",
-                  where, present < expected ? "truncated" : "trailing bytes", shape_text(h.shape),
-                  h.descr, expected, present);
-  HNN_TASKS_CHECK(h.shape[0] > 0 && (h.shape.size() == 1 || h.shape[1] > 0),
-                  "{}: an empty array (shape {})", where, shape_text(h.shape));
+                  where, present < expected ? "truncated" : "trailing bytes",
+                  reader::shape_text(h.shape), h.descr, expected, present);
+  HNN_TASKS_CHECK(std::find(h.shape.begin(), h.shape.end(), std::size_t{0}) == h.shape.end(),
+                  "{}: an empty array (shape {})", where, reader::shape_text(h.shape));
   return word;
 }
 
+// The array as rows x its last axis: a 1-D array is one column, a 3-D one (n, m, k) has row
+// i * m + j for [i, j, :].
 template <typename T>
 Eigen::MatrixXd to_columns(xt::detail::npy_file&& file, const std::vector<std::size_t>& shape) {
   const auto array = std::move(file).cast<T>();
-  const auto rows = Eigen::Index(shape[0]);
-  const auto cols = Eigen::Index(shape.size() == 2 ? shape[1] : 1);
+  const std::size_t inner = shape.size() == 3 ? shape[1] : 1;
+  const auto rows = Eigen::Index(shape[0] * inner);
+  const auto cols = Eigen::Index(shape.size() >= 2 ? shape.back() : 1);
   Eigen::MatrixXd out(rows, cols);
   for (Eigen::Index i = 0; i < rows; ++i) {
+    const std::size_t a = std::size_t(i) / inner, b = std::size_t(i) % inner;
     for (Eigen::Index j = 0; j < cols; ++j) {
-      out(i, j) = shape.size() == 2 ? double(array(std::size_t(i), std::size_t(j)))
-                                    : double(array(std::size_t(i)));
+      const auto c = std::size_t(j);
+      out(i, j) = double(shape.size() == 3   ? array(a, b, c)
+                         : shape.size() == 2 ? array(a, c)
+                                             : array(a));
     }
   }
   return out;
@@ -128,15 +136,19 @@ void check_finite(const Array& a, const std::string& where) {
       if (std::isfinite(v)) continue;
       if (a.shape.size() == 1)
         throw Error(fmt::format("{}, row {}: {} is not finite", where, i, v));
+      if (a.shape.size() == 3) {
+        throw Error(fmt::format("{}, [{}, {}, {}]: {} is not finite", where,
+                                std::size_t(i) / a.shape[1], std::size_t(i) % a.shape[1], j, v));
+      }
       throw Error(fmt::format("{}, row {}, column {}: {} is not finite", where, i, j, v));
     }
   }
 }
 
 // `where` names the file, or the file and the npz member.
-Array parse_npy(const std::string& bytes, const std::string& where, std::size_t min_rank) {
+Array parse_npy(const std::string& bytes, const std::string& where, Ranks ranks) {
   const NpyHeader header = read_npy_header(bytes, where);
-  const std::size_t word = check_npy_header(header, bytes, where, min_rank);
+  const std::size_t word = check_npy_header(header, bytes, where, ranks);
   std::istringstream in(bytes);
   Array array{header.shape, {}};
   try {
@@ -216,7 +228,7 @@ void add_columns(Table& table, const std::string& name, const Array& array,
 }  // namespace
 
 Table read_npy(const std::string& path) {
-  const Array array = parse_npy(reader::read_bytes(path), path, 2);
+  const Array array = parse_npy(reader::read_bytes(path), path, kNpyRanks);
   Table table{path, TableFormat::kNpy, {}, {}, {}, {}};
   for (Eigen::Index j = 0; j < array.columns.cols(); ++j) table.names.push_back(std::to_string(j));
   table.values = array.columns;
@@ -227,9 +239,7 @@ Table read_npz(const std::string& path) {
   reader::check_readable(path);
   const ZipArchive archive = open_zip(path);
   const std::uintmax_t archive_bytes = std::filesystem::file_size(path);
-  Table table{path, TableFormat::kNpz, {}, {}, {}, {}};
-  std::vector<Eigen::MatrixXd> blocks;
-  std::string first;
+  std::vector<std::pair<std::string, Array>> arrays;
   const zip_int64_t entries = zip_get_num_entries(archive.get(), 0);
   for (zip_int64_t i = 0; i < entries; ++i) {
     zip_stat_t stat;
@@ -243,19 +253,26 @@ Table read_npz(const std::string& path) {
                     member);
     const std::string name = member.substr(0, member.size() - 4);
     const std::string where = fmt::format("{}: array '{}'", path, name);
-    add_columns(table, name,
-                parse_npy(read_member(archive.get(), zip_uint64_t(i), stat, archive_bytes, where),
-                          where, 1),
-                blocks, first);
+    arrays.emplace_back(
+        name, parse_npy(read_member(archive.get(), zip_uint64_t(i), stat, archive_bytes, where),
+                        where, kNpzRanks));
   }
-  HNN_TASKS_CHECK(!blocks.empty(), "{}: the archive holds no arrays", path);
+  HNN_TASKS_CHECK(!arrays.empty(), "{}: the archive holds no arrays", path);
+  Table table{path, TableFormat::kNpz, {}, {}, {}, {}};
+  if (const auto shape = reader::trajectory_shape(arrays)) {
+    reader::trajectory_columns(arrays, *shape, table);
+  } else {
+    std::vector<Eigen::MatrixXd> blocks;
+    std::string first;
+    for (const auto& [name, array] : arrays) add_columns(table, name, array, blocks, first);
+    table.values.resize(blocks[0].rows(), Eigen::Index(table.names.size()));
+    Eigen::Index column = 0;
+    for (const Eigen::MatrixXd& block : blocks) {
+      table.values.middleCols(column, block.cols()) = block;
+      column += block.cols();
+    }
+  }
   reader::check_unique_names(table.names, path);
-  table.values.resize(blocks[0].rows(), Eigen::Index(table.names.size()));
-  Eigen::Index column = 0;
-  for (const Eigen::MatrixXd& block : blocks) {
-    table.values.middleCols(column, block.cols()) = block;
-    column += block.cols();
-  }
   return table;
 }
 

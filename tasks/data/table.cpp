@@ -94,6 +94,12 @@ Table read_table(const std::string& path) {
 
 namespace reader {
 
+std::string shape_text(const std::vector<std::size_t>& shape) {
+  std::string text;
+  for (std::size_t d : shape) text += (text.empty() ? "" : "x") + std::to_string(d);
+  return shape.empty() ? "a scalar" : text;
+}
+
 void check_readable(const std::string& path) {
   std::error_code ec;
   HNN_TASKS_CHECK(fs::exists(path, ec), "{}: no such file", path);

@@ -132,6 +132,8 @@ class DataRun : public FieldModelRun {
     if (folder) {
       folder->write_text("rollout.csv",
                          held_out_csv(held, p_.measured.state_names, nn::to_string(s_.model)));
+      // Said once the run has gone through: an error before it stays the one line on stderr.
+      fmt::print(stderr, "hnn: data: {}\n", derivatives_source(p_.measured));
     }
     return m;
   }

@@ -201,7 +201,7 @@ TEST_F(ParameterFile, FailedSaveLeavesNoTemporaryFile) {
   std::mt19937_64 rng(6);
   const nn::Baseline<double> model(small_config(ModelKind::kBaseline, 2, {4}), rng);
   const fs::path nowhere = file("no/such/dir/model.bin");
-  expect_refusal([&] { nn::save_parameters(nowhere, model); }, nowhere, "temporary file");
+  expect_refusal([&] { nn::save_parameters(nowhere, model); }, nowhere, "does not exist");
   EXPECT_TRUE(listing().empty());
 }
 

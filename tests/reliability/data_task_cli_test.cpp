@@ -28,6 +28,11 @@ TEST(DataTaskCli, TrainsOnASimulatedFileAndRefusesBadOptionsInOneLine) {
                                          "--hidden", "8",         "--quiet", "--out",   out};
   const Result good = run_hnn(base, dir.path());
   ASSERT_EQ(good.code, 0) << good.err;
+  // simulate's exact dx/dt columns, found by their names, and said so.
+  EXPECT_NE(
+      good.err.find("hnn: data: " + csv + ": dx/dt from the columns dq/dt, dp/dt, found by name"),
+      std::string::npos)
+      << good.err;
   const nlohmann::json m = read_json(dir / "run" / "metrics.json");
   EXPECT_EQ(m["task_settings"], nlohmann::json({{"coords", {"q"}}, {"momenta", {"p"}}}));
   EXPECT_TRUE(fs::exists(dir / "run" / "rollout.csv"));

@@ -170,8 +170,12 @@ TEST(Simulate, BadOptionsGetOneLineAndNoFile) {
       {{"--dt", "nan"}, "--dt: expected a finite number > 0, got 'nan' (see --help)\n"},
       {{"--trajectories", "10000000", "--points", "100"},
        "--trajectories 10000000 x --points 100 is more than 1e+08 rows\n"},
+      {{"--hamiltonian", "p^2/2 + q**4"},
+       "hamiltonian 'p^2/2 + q**4' does not parse: unexpected token, got: \"*\" (write powers with "
+       "^: q^4, not q**4)\n"},
       {{"--out", (dir / "missing" / "x.csv").string()},
-       "cannot write '" + (dir / "missing" / "x.csv").string()},
+       "cannot write '" + (dir / "missing" / "x.csv").string() + "' (its folder '" +
+           (dir / "missing").string() + "' does not exist): No such file or directory\n"},
   };
   const fs::path out = dir / "out.csv";
   for (const BadSimulate& bad : cases) {

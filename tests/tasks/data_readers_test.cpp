@@ -156,7 +156,9 @@ TEST_F(NumpyReader, EveryBadArrayIsOneLineNamingFileArrayAndWhat) {
     std::string path, message;
   } cases[] = {
       {bad("int64.npy"), ": holds '<i8' values; only float64 ('<f8') and float32 ('<f4') are read"},
-      {bad("three_d.npy"), ": an array of shape 2x3x4; a 2-D array (rows x columns) is needed"},
+      {bad("three_d.npy"),
+       ": an array of shape 2x3x4; a 2-D array (rows x columns) is needed (trajectories x times "
+       "x components need their times: save them in an .npz, numpy.savez(FILE, x=x, t=t))"},
       {bad("one_d.npy"), ": an array of shape 6; a 2-D array (rows x columns) is needed"},
       {bad("nan.npy"), ", row 1, column 1: nan is not finite"},
       {cut_copy("quadratic.npy", 200),

@@ -53,9 +53,10 @@ TEST_F(MeasuredDataErrors, BadColumnChoices) {
             "FILE: column 'time' is chosen twice (as the time and as a coordinate)");
   EXPECT_EQ(message(kFile, {.coords = {"q"}, .momenta = {"p"}, .trajectory = "q"}),
             "FILE: column 'q' is chosen twice (as the trajectory id and as a coordinate)");
-  EXPECT_EQ(message("a,q,p\n0,0,0\n", qp()),
-            "FILE: no time column (none is named t or time): give it by name or index (columns: "
-            "a, q, p)");
+  EXPECT_EQ(
+      message("a,q,p\n0,0,0\n", qp()),
+      "FILE: no time column (none is named t, time or times): give it by name or index (columns: "
+      "a, q, p)");
 }
 
 TEST_F(MeasuredDataErrors, NpzCoordinatesAndMomentaOfDifferentCounts) {
