@@ -87,6 +87,8 @@ struct RunOptions {
   nlohmann::json task_settings = nlohmann::json::object();
   std::filesystem::path out{};
   bool quiet = false;
+  /// Print metrics.json's content when done, instead of a summary a person reads.
+  bool print_json = false;
   /// Checkpoints into out/checkpoint every this many steps (default: a tenth of the steps), at
   /// the end, and when stopped.
   std::optional<long> checkpoint_every{};

@@ -8,6 +8,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "tasks/evaluate/reversibility.h"
 #include "tasks/options.h"
@@ -24,6 +25,16 @@ RunSettings validate(const RunOptions& options);
 /// Trains and evaluates one model; writes the run folder `options.out` and returns metrics.json's
 /// content. Throws on bad options or data (nothing half-written is left: each file is atomic).
 nlohmann::json run_training(const RunOptions& options);
+
+/// The test R^2 below which a run is said to explain almost nothing of dx/dt.
+inline constexpr double kLowR2 = 0.1;
+
+/// metrics.json's "warnings": each a sentence about a run that ended no better than it started.
+/// Two tests: the loss curve's last test loss (its train loss where a task has no test loss) is
+/// not below its first recorded one, and the test R^2 (where a task reports one) is below
+/// kLowR2. An empty curve (a run evaluated again) skips the first.
+std::vector<std::string> run_warnings(const std::vector<CurvePoint>& curve,
+                                      const nlohmann::json& metrics);
 
 /// A finished run loaded back: its settings, its task and the run (data and trained model).
 struct LoadedRun {
