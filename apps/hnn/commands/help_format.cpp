@@ -6,7 +6,7 @@ namespace {
 
 // The placeholder of an option's value, from CLI11's type name ("INT:INT", "TEXT:{a,b}",
 // "TEXT:DIR"): what it takes, without the tag.
-std::string placeholder(const CLI::Option* opt) {
+std::string value_placeholder(const CLI::Option* opt) {
   const std::string type = opt->get_type_name();
   const std::string base = type.substr(0, type.find(':'));
   if (type.find(":DIR") != std::string::npos) return "DIR";
@@ -24,7 +24,7 @@ std::string HelpFormatter::make_option_opts(const CLI::Option* opt) const {
   if (!opt->get_option_text().empty()) {
     out = " " + opt->get_option_text();
   } else if (opt->get_type_size() != 0 && opt->nonpositional()) {
-    out = " " + placeholder(opt);
+    out = " " + value_placeholder(opt);
     if (opt->get_expected_max() >= CLI::detail::expected_max_vector_size) out += " ...";
   }
   if (opt->get_required()) out += " " + get_label("REQUIRED");

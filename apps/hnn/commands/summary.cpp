@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <optional>
+#include <utility>
 #include <vector>
 
 namespace hnn::app {
@@ -38,14 +39,14 @@ std::string text_at(const json& m, const std::string& key) {
 }
 
 // "spring hnn: seed 0, 2000 steps, hidden 200-200, double".
-std::string heading(const json& m) {
+std::string heading_line(const json& m) {
   return fmt::format("{} {}: seed {}, {} steps, hidden {}, {}", text_at(m, "task"),
                      text_at(m, "model"), text_at(m, "seed"), text_at(m, "steps"),
                      text_at(m, "hidden"), text_at(m, "dtype"));
 }
 
 // "  loss     test 3.1e-02 ± 1e-03, train 3e-02 ± 1e-03; R² test 0.998, train 0.999".
-std::string losses(const json& m) {
+std::string loss_lines(const json& m) {
   std::string line = fmt::format("  loss       test {}, train {}", with_se(m, "test_loss"),
                                  with_se(m, "train_loss"));
   if (const auto r2 = number_at(m, "test_r2")) {
@@ -63,7 +64,7 @@ std::string losses(const json& m) {
 }
 
 // The valid prediction time, beside the truth's own (perturbed by 1e-4) where known.
-std::string prediction(const json& m) {
+std::string prediction_line(const json& m) {
   const std::string valid = with_se(m, "valid_prediction_time");
   if (valid.empty()) return "";
   std::string line = fmt::format("  rollouts   valid prediction time {}", valid);
@@ -75,7 +76,7 @@ std::string prediction(const json& m) {
 }
 
 // The energy error against the true H: absolute and relative; or why there is none.
-std::string energy(const json& m) {
+std::string energy_lines(const json& m) {
   std::string out;
   if (const std::string mse = with_se(m, "energy_mse"); !mse.empty()) {
     out += fmt::format("  energy     MSE {} against the true H", mse);
@@ -90,11 +91,11 @@ std::string energy(const json& m) {
   return out;
 }
 
-std::string timing(const json& m) {
+std::string timing_line(const json& m) {
+  constexpr std::pair<const char*, const char*> kTimes[] = {
+      {"train_seconds", "training"}, {"data_seconds", "data"}, {"eval_seconds", "evaluation"}};
   std::vector<std::string> parts;
-  for (const auto& [key, name] : {std::pair{"train_seconds", "training"},
-                                  {"data_seconds", "data"},
-                                  {"eval_seconds", "evaluation"}}) {
+  for (const auto& [key, name] : kTimes) {
     if (const auto s = number_at(m, key)) parts.push_back(fmt::format("{} {:.1f} s", name, *s));
   }
   if (parts.empty()) return "";
@@ -106,7 +107,8 @@ std::string timing(const json& m) {
 }  // namespace
 
 std::string metrics_summary(const json& m) {
-  return heading(m) + "\n" + losses(m) + prediction(m) + energy(m) + timing(m);
+  return heading_line(m) + "\n" + loss_lines(m) + prediction_line(m) + energy_lines(m) +
+         timing_line(m);
 }
 
 void print_warnings(const json& metrics) {
