@@ -236,7 +236,7 @@ TEST(CliTrain, PrintsASummaryNotTheJson) {
 
 TEST(CliHelp, HasNoTypeTagsAndStatesDefaultsAndFormats) {
   const std::regex tag(
-      R"(\b(INT|UINT|UINT64|FLOAT|TEXT|BOOLEAN)\b|:\{|:(POSITIVE|NONNEGATIVE|DIR|FILE)\b)");
+      R"(\b(INT|UINT|UINT64|FLOAT|BOOLEAN)\b|:\{|:(POSITIVE|NONNEGATIVE|DIR|FILE)\b)");
   for (const std::string& name : subcommands(hnn("--help").out)) {
     const std::string help = hnn(name + " --help").out;
     std::smatch m;

@@ -14,7 +14,7 @@ std::string value_placeholder(const CLI::Option* opt) {
   if (type.find(":{") != std::string::npos) return "NAME";
   if (base == "INT" || base == "UINT") return "N";
   if (base == "FLOAT") return "X";
-  return "VALUE";
+  return "TEXT";
 }
 
 }  // namespace
@@ -23,7 +23,7 @@ std::string HelpFormatter::make_option_opts(const CLI::Option* opt) const {
   std::string out;
   if (!opt->get_option_text().empty()) {
     out = " " + opt->get_option_text();
-  } else if (opt->get_type_size() != 0 && opt->nonpositional()) {
+  } else if (opt->get_type_size() != 0 && !opt->get_type_name().empty() && opt->nonpositional()) {
     out = " " + value_placeholder(opt);
     if (opt->get_expected_max() >= CLI::detail::expected_max_vector_size) out += " ...";
   }
