@@ -153,9 +153,11 @@ void add_simulate_command(CLI::App& app) {
       ->option_text("EXPR")
       ->required();
   cmd->add_option("--coords", o->coords, "Coordinate names, in order (repeat or comma-separate)")
+      ->option_text("NAME ...")
       ->required()
       ->delimiter(',');
   cmd->add_option("--momenta", o->momenta, "Momentum names, one per coordinate")
+      ->option_text("NAME ...")
       ->required()
       ->delimiter(',');
   cmd->add_option("--trajectories", o->trajectories, "Trajectories")
@@ -174,6 +176,7 @@ void add_simulate_command(CLI::App& app) {
                   fmt::format("One of {} (the splitting methods leapfrog, yoshida4 and "
                               "symplectic_euler need a separable H)",
                               fmt::join(physics::integrator_names(), ", ")))
+      ->option_text("NAME")
       ->capture_default_str();
   cmd->add_option("--dt", o->dt, "Step of fixed-step integrators")
       ->check(positive_real())
@@ -190,7 +193,7 @@ void add_simulate_command(CLI::App& app) {
   cmd->add_option("--energy", o->energy,
                   "Keep only initial states with LO <= H <= HI, given as LO:HI (e.g. 0.5:2)")
       ->option_text("LO:HI");
-  cmd->add_option("--out", o->out, "CSV file to write")->required();
+  cmd->add_option("--out", o->out, "CSV file to write")->option_text("FILE")->required();
   cmd->callback([o] { simulate(*o); });
 }
 
