@@ -97,6 +97,8 @@ struct RunOptions {
   /// Replace the run already in `out`: its files are removed once the new run's data are read.
   bool force = false;
   bool quiet = false;
+  /// Print metrics.json's content when done, instead of a summary a person reads.
+  bool print_json = false;
   /// Checkpoints into out/checkpoint every this many steps (default: a tenth of the steps), at
   /// the end, and when stopped.
   std::optional<long> checkpoint_every{};

@@ -45,14 +45,15 @@ const TrainOption kOptions[] = {
      .noun = "model"},
     {.name = "steps",
      .kind = ValueKind::kInt,
-     .help = "Training steps (default: the paper's); with --resume, more than a finished "
+     .help = "Training steps; with --resume, more than a finished "
              "run's: continue it to this many",
      .continues_resume = true,
      .sweep_rank = 6,
      .lands = Lands::kSteps,
      .key = "steps",
      .min = 1,
-     .max = kIntMax},
+     .max = kIntMax,
+     .default_by_task = true},
     {.name = "seed",
      .kind = ValueKind::kSeed,
      .help = "Seed of the data, initialisation and batches",
@@ -93,33 +94,37 @@ const TrainOption kOptions[] = {
      .noun = "preset"},
     {.name = "batch",
      .kind = ValueKind::kInt,
-     .help = "Minibatch size (0: full batch; default: the paper's)",
+     .help = "Minibatch size (0: the full training set)",
      .sweep_rank = 7,
      .lands = Lands::kBatchSize,
      .key = "batch_size",
      .min = 0,
-     .max = kIntMax},
+     .max = kIntMax,
+     .default_by_task = true},
     {.name = "hidden",
      .kind = ValueKind::kHidden,
-     .help = "Hidden widths, e.g. --hidden 200 200",
+     .help = "Hidden widths, e.g. --hidden 200 200 (overrides --preset)",
      .sweep_rank = 5,
      .lands = Lands::kHidden,
-     .key = "hidden"},
+     .key = "hidden",
+     .default_by_task = true},
     {.name = "lr",
      .kind = ValueKind::kPositiveReal,
-     .help = "Adam learning rate (default 1e-3)",
+     .help = "Adam learning rate",
      .sweep_rank = 8,
      .lands = Lands::kLearningRate,
-     .key = "learning_rate"},
+     .key = "learning_rate",
+     .default_by_task = true},
     {.name = "lr-schedule",
      .kind = ValueKind::kChoice,
-     .help = "constant (the default) or cosine: decay from --lr towards 0 at the last step",
+     .help = "constant or cosine: decay from --lr towards 0 at the last step",
      .sweep_rank = 9,
      .lands = Lands::kLrSchedule,
      .key = "lr_schedule",
      .recorded_default = R"("constant")",  // runs from before the schedules
      .choices = lr_schedule_names,
-     .noun = "learning-rate schedule"},
+     .noun = "learning-rate schedule",
+     .default_by_task = true},
     {.name = "data",
      .kind = ValueKind::kFile,
      .help = "The data task's file, or real-pendulum's measured data in its format; with "
@@ -146,6 +151,12 @@ const TrainOption kOptions[] = {
      .with_resume = true,
      .sweep_owned = "hnn sweep runs quietly",
      .lands = Lands::kQuiet},
+    {.name = "json",
+     .kind = ValueKind::kFlag,
+     .help = "Print metrics.json's content on stdout instead of the summary",
+     .with_resume = true,
+     .sweep_owned = "hnn sweep reads each run's metrics.json",
+     .lands = Lands::kPrintJson},
     {.name = "settings",
      .kind = ValueKind::kJsonObject,
      .help = "The task's own settings as a JSON object, e.g. pixel-pendulum's '{\"trials\": 20, "
@@ -214,7 +225,9 @@ const TrainOption kOptions[] = {
      .key = "trajectory"},
     {.name = "split",
      .kind = ValueKind::kChoice,
-     .help = "Test split: auto, trajectories or time",
+     .help = "Test split: trajectories (the last --test-fraction of the trajectories held out), "
+             "time (the last --test-fraction of each trajectory's rows) or auto (the default: "
+             "by trajectories when the file has more than one, else by time)",
      .group = kDataGroup,
      .sweep_rank = 19,
      .applies_to = AppliesTo::kDataTask,
@@ -223,7 +236,8 @@ const TrainOption kOptions[] = {
      .noun = "split"},
     {.name = "test-fraction",
      .kind = ValueKind::kFraction,
-     .help = "Share of the trajectories (or of each one's rows) held out (default 0.2)",
+     .help = "Share of the trajectories (or of each one's rows) held out, in (0, 1) (default "
+             "0.2)",
      .group = kDataGroup,
      .sweep_rank = 20,
      .applies_to = AppliesTo::kDataTask,
@@ -247,7 +261,7 @@ const TrainOption kOptions[] = {
      .noun = "loss"},
     {.name = "horizon",
      .kind = ValueKind::kInt,
-     .help = "Sampling intervals per rollout window (default 1)",
+     .help = "Sampling intervals per rollout window, 1 to 1000 (default 1)",
      .group = kRolloutGroup,
      .sweep_rank = 23,
      .applies_to = AppliesTo::kFieldTasks,
@@ -257,7 +271,7 @@ const TrainOption kOptions[] = {
      .range_in_help = true},
     {.name = "integrator",
      .kind = ValueKind::kChoice,
-     .help = "The rollout loss's integrator: leapfrog, yoshida4, midpoint or rk4 (default)",
+     .help = "The rollout loss's integrator: one of {} (default rk4)",
      .group = kRolloutGroup,
      .sweep_rank = 24,
      .applies_to = AppliesTo::kFieldTasks,
@@ -334,6 +348,9 @@ void apply(const TrainOption& option, const json& v, RunOptions& o) {
       return;
     case Lands::kQuiet:
       o.quiet = v.get<bool>();
+      return;
+    case Lands::kPrintJson:
+      o.print_json = v.get<bool>();
       return;
     case Lands::kTaskSettings: {
       // The keys already set by their own options stay (the data task's, the rollout loss's).

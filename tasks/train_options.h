@@ -58,6 +58,7 @@ enum class Lands {
   kDataFile,
   kOut,
   kQuiet,
+  kPrintJson,
   kTaskSettings,
   kCheckpointEvery,
   kResume,  ///< out, with resume set: the rest comes from the checkpoint (run.h resume_options)
@@ -68,7 +69,7 @@ enum class Lands {
 struct TrainOption {
   std::string_view name;  ///< "model" is --model; the kTask option is the positional TASK
   ValueKind kind;
-  std::string_view help;        ///< --help's text; for kTask, "{}" stands for the list of tasks
+  std::string_view help;        ///< --help's text; "{}": the tasks (kTask) or choices (kChoice)
   std::string_view group = "";  ///< --help's heading; "" the general options
   std::string_view default_shown = "";  ///< --help's default: RunOptions{}'s value, as text
   bool with_resume = false;             ///< may be given with --resume: cannot change a result
@@ -83,9 +84,11 @@ struct TrainOption {
   /// RunSettings::to_json's key in runs from before it existed, as JSON; "": always there.
   std::string_view recorded_default = "";
   long long min = 0, max = 0;                       ///< kInt's range
-  bool range_in_help = false;                       ///< kInt: --help shows the range
+  bool range_in_help = false;                       ///< kInt: checked by CLI::Range
   std::vector<std::string> (*choices)() = nullptr;  ///< kChoice's names
   std::string_view noun = "";                       ///< kChoice: "unknown {noun} 'x'"
+  /// --help's default is each task's own: RunSettings::to_json's `key` for the task alone.
+  bool default_by_task = false;
 };
 
 /// Every option, in the order of `hnn train --help`.

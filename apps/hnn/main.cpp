@@ -8,10 +8,13 @@
 #include <filesystem>
 
 #include "apps/hnn/commands/commands.h"
+#include "apps/hnn/commands/help_format.h"
 #include "nn/atomic_file.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"hnn: Hamiltonian Neural Networks (Greydanus et al. 2019) in C++"};
+  app.formatter(std::make_shared<hnn::app::HelpFormatter>());  // before the subcommands copy it
+  app.set_version_flag("--version", "hnn " HNN_VERSION);
   app.require_subcommand(1);
   hnn::app::add_train_command(app);
   hnn::app::add_evaluate_command(app);
@@ -27,7 +30,7 @@ int main(int argc, char** argv) {
   } catch (const CLI::RuntimeError& e) {
     return e.get_exit_code();  // already reported (a stopped training run)
   } catch (const CLI::ParseError& e) {
-    if (e.get_exit_code() == 0) return app.exit(e);  // --help
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
     std::string message = e.what();
     std::replace(message.begin(), message.end(), '\n', ' ');
     fmt::print(stderr, "hnn: error: {} (see --help)\n", message);

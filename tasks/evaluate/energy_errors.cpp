@@ -42,6 +42,21 @@ nn::MeanStderr energy_mse(const Rollouts& r) {
   return out;
 }
 
+nn::MeanStderr relative_energy_mse(const Rollouts& r) {
+  nn::MeanStderr out = energy_mse(r);
+  double sum = 0;
+  Eigen::Index points = 0;
+  for (std::size_t i = 0; i < r.failed.size(); ++i) {
+    if (r.failed[i]) continue;
+    sum += r.true_energy.row(Eigen::Index(i)).squaredNorm();
+    points += r.true_energy.cols();
+  }
+  const double mean_square = points > 0 ? sum / double(points) : NAN;
+  out.mean = mean_square > 0 ? out.mean / mean_square : NAN;
+  out.std_error = mean_square > 0 ? out.std_error / mean_square : NAN;
+  return out;
+}
+
 nn::MeanStderr energy_error_at_end(const Rollouts& r, double scale) {
   std::vector<double> errors;
   const Eigen::Index end = r.true_energy.cols() - 1;

@@ -41,6 +41,7 @@ double dissipation_share(const nn::DynamicsModel<double>& model, const Batch& x,
 
 json rollout_metrics(const Rollouts& r, double threshold) {
   const nn::MeanStderr energy = energy_mse(r);
+  const nn::MeanStderr relative_e = relative_energy_mse(r);
   const nn::MeanStderr state = state_mse(r);
   const RelativeError relative = relative_error(r, threshold);
   const RelativeError floor = relative_error_floor(r, threshold);
@@ -52,6 +53,8 @@ json rollout_metrics(const Rollouts& r, double threshold) {
             {"energy_mse", measured ? json(nullptr) : number(energy.mean)},
             {"energy_mse_se", measured ? json(nullptr) : number(energy.std_error)},
             {"energy_mse_count", measured ? 0 : energy.count},
+            {"energy_relative_mse", measured ? json(nullptr) : number(relative_e.mean)},
+            {"energy_relative_mse_se", measured ? json(nullptr) : number(relative_e.std_error)},
             {"state_mse", number(state.mean)},
             {"state_mse_se", number(state.std_error)},
             {"state_mse_count", state.count},

@@ -33,7 +33,8 @@ double dissipation_share(const nn::DynamicsModel<double>& model, const Batch& x,
                          const std::function<Batch(const Batch&)>& to_data_units = {});
 
 /// The metrics of rollouts, each with its standard error and count (over the learned rollouts
-/// that did not fail): energy MSE (null for measured truth), state MSE, the relative error's
+/// that did not fail): energy MSE and its relative form (energy_relative_mse, energy_errors.h;
+/// both null for measured truth), state MSE, the relative error's
 /// geometric mean and its floor (Note [Perturbed truth], rollouts.h), the valid prediction time
 /// (until the relative error passes `threshold`) and the floor's (valid_prediction_time_floor:
 /// where the system's own sensitivity ends predictability), and at each horizon

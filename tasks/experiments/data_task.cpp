@@ -92,6 +92,29 @@ Prepared prepare(const RunSettings& s) {
   return p;
 }
 
+// The same losses in the model's standardised units (x - mean) / scale, t / time: those of
+// loss_curve.csv and the progress line, under their names with "_standardised".
+json standardised_losses(const LearnedField& model, const Dataset& z) {
+  const nn::MeanStderr train = loss_stats(model.field, z.train_x, z.train_dxdt);
+  const nn::MeanStderr test = loss_stats(model.field, z.test_x, z.test_dxdt);
+  return {{"train_loss_standardised", number(train.mean)},
+          {"train_loss_standardised_se", number(train.std_error)},
+          {"test_loss_standardised", number(test.mean)},
+          {"test_loss_standardised_se", number(test.std_error)}};
+}
+
+// metrics.json's "units": the standardisation, and which keys and files are in which units.
+json units_statement(const Units& u) {
+  json j = u.to_json();
+  j["standardised"] = {"train_loss_standardised", "train_loss_standardised_se",
+                       "test_loss_standardised",  "test_loss_standardised_se",
+                       "loss_curve.csv",          "the progress line of hnn train"};
+  j["file"] =
+      "every other loss, error, time and energy (train_loss, test_loss, energy_mse, ...): the data "
+      "file's own units";
+  return j;
+}
+
 class DataRun : public FieldModelRun {
  public:
   DataRun(RunSettings settings, Prepared p)
@@ -100,6 +123,13 @@ class DataRun : public FieldModelRun {
     const SplitStretches stretches{in_model_units(p_.measured.train_stretches),
                                    in_model_units(p_.measured.held_out)};
     training_ = FieldTraining(s_.loss, &stretches, s_.train, "data", p_.units.time);
+  }
+
+  // The progress line shows the training loss in the model's units: it says so.
+  TrainResult train(const LoopOptions& loop) override {
+    LoopOptions labelled = loop;
+    if (p_.config.standardize) labelled.label += " (standardised units)";
+    return FieldModelRun::train(labelled);
   }
 
   json evaluate(const RunFolder* folder) const override {
@@ -116,6 +146,7 @@ class DataRun : public FieldModelRun {
               {"test_r2", number(r_squared(test.mean, d.test_dxdt))},
               {"n_train", d.train_x.rows()},
               {"n_test", d.test_x.rows()}};
+    m.update(standardised_losses(model, data_));
     const HeldOutEvaluation held = evaluate_held_out(
         model, p_.units, p_.measured.held_out, p_.measured.coordinates, data_.train_x,
         {.threshold = p_.config.threshold, .truth = p_.truth.get()});
@@ -126,7 +157,7 @@ class DataRun : public FieldModelRun {
     }
     m.update(energy_metrics(file));
     m["training"] = s_.loss.to_json();
-    m["units"] = p_.units.to_json();
+    m["units"] = units_statement(p_.units);
     m["state_names"] = p_.measured.state_names;
     m["data"] = describe(p_.measured);
     if (folder) {
@@ -253,6 +284,8 @@ class DataRun : public FieldModelRun {
     if (!p_.truth) {
       return {{"energy_mse", nullptr},
               {"energy_mse_se", nullptr},
+              {"energy_relative_mse", nullptr},
+              {"energy_relative_mse_se", nullptr},
               {"energy_note", "no known Hamiltonian: give one with --hamiltonian EXPR"},
               {"relative_error_floor_note",
                "no known Hamiltonian to perturb (--hamiltonian EXPR gives "
@@ -274,6 +307,8 @@ class DataRun : public FieldModelRun {
     json out = {{"energy_mse", m["energy_mse"]},
                 {"energy_mse_se", m["energy_mse_se"]},
                 {"energy_mse_count", m["energy_mse_count"]},
+                {"energy_relative_mse", m["energy_relative_mse"]},
+                {"energy_relative_mse_se", m["energy_relative_mse_se"]},
                 {"n_rollouts", m["n_rollouts"]},
                 {"rollouts", m["rollouts"]},
                 {"rollout_failures", r.failures},

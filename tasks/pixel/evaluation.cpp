@@ -96,9 +96,12 @@ json loss_metrics(const PixelLossStats& train, const PixelLossStats& test) {
 json rollout_metrics(const PixelRollouts& r, const PixelConfig& config) {
   const nn::MeanStderr energy = pixel_energy_mse(r);
   const nn::MeanStderr within_pair = pixel_energy_mse(r, EnergySource::kWithinPair);
+  const nn::MeanStderr relative = pixel_relative_energy_mse(r);
   const Eigen::VectorXd frame_mse = mean_frame_mse(r);
   return {{"energy_mse", number(energy.mean)},
           {"energy_mse_se", number(energy.std_error)},
+          {"energy_relative_mse", number(relative.mean)},
+          {"energy_relative_mse_se", number(relative.std_error)},
           {"n_rollouts", energy.count},
           {"rollout_failures", r.failures},
           {"energy_mse_frames_floor", number(pixel_energy_mse(r, EnergySource::kTrueFrames).mean)},

@@ -103,7 +103,10 @@ PixelRollouts pixel_rollouts(const PixelModel<double>& model, const PixelData& d
   return r;
 }
 
-nn::MeanStderr pixel_energy_mse(const PixelRollouts& r, EnergySource source) {
+namespace {
+
+// The rollouts' energies as tasks::energy_mse reads them, from `source`.
+Rollouts energy_view(const PixelRollouts& r, EnergySource source) {
   Rollouts view;
   view.t = r.t;
   view.failed = r.failed;
@@ -115,7 +118,17 @@ nn::MeanStderr pixel_energy_mse(const PixelRollouts& r, EnergySource source) {
   for (Eigen::Index i = 0; i < view.pred_energy.rows(); ++i) {
     if (!view.pred_energy.row(i).allFinite()) view.failed[std::size_t(i)] = true;
   }
-  return energy_mse(view);
+  return view;
+}
+
+}  // namespace
+
+nn::MeanStderr pixel_energy_mse(const PixelRollouts& r, EnergySource source) {
+  return energy_mse(energy_view(r, source));
+}
+
+nn::MeanStderr pixel_relative_energy_mse(const PixelRollouts& r) {
+  return relative_energy_mse(energy_view(r, EnergySource::kRollout));
 }
 
 }  // namespace hnn::tasks::pixel

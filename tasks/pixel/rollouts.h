@@ -41,5 +41,7 @@ enum class EnergySource {
 /// Energy MSE over trajectories and times with the 5-split standard error of tasks::energy_mse.
 nn::MeanStderr pixel_energy_mse(const PixelRollouts& rollouts,
                                 EnergySource source = EnergySource::kRollout);
+/// tasks::relative_energy_mse of the rollout's recovered energy (the headline metric's).
+nn::MeanStderr pixel_relative_energy_mse(const PixelRollouts& rollouts);
 
 }  // namespace hnn::tasks::pixel

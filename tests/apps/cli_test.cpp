@@ -2,6 +2,7 @@
 // `rollout` on its run folder, and a quick `hnn reproduce` writing Table 1. (Bad input and its
 // one-line errors are tested in tests/reliability.)
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
@@ -10,6 +11,7 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <regex>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -134,12 +136,14 @@ TEST(CliHelp, EverySubcommandHasHelpListingItsOptions) {
 
 TEST(CliTrain, ShortRunWritesTheRunFolderAndPrintsItsMetrics) {
   TempDir dir("run");
-  const Result r = hnn("train spring --steps 20 --hidden 16 16 --out " + dir.str() + " --quiet");
+  const Result r =
+      hnn("train spring --steps 20 --hidden 16 16 --out " + dir.str() + " --quiet --json");
   ASSERT_EQ(r.exit_code, 0) << r.out;
   for (const char* file : {"metrics.json", "loss_curve.csv", "rollout.csv", "params.bin"})
     EXPECT_TRUE(fs::is_regular_file(dir.path() / file)) << file;
   const json m = json::parse(read_text(dir.path() / "metrics.json"));
-  EXPECT_EQ(json_in(r.out), m);
+  EXPECT_EQ(json_in(r.out), m);  // --json: metrics.json's content, and nothing else
+  EXPECT_EQ(r.out.front(), '{');
   EXPECT_EQ(m["task"], "spring");
   EXPECT_EQ(m["model"], "hnn");
   EXPECT_EQ(m["steps"], 20);
@@ -178,7 +182,7 @@ TEST(CliEvaluateAndRollout, WorkOnASavedRun) {
             0);
   const json trained = json::parse(read_text(dir.path() / "metrics.json"));
   // evaluate: the same numbers from the saved parameters.
-  const Result e = hnn("evaluate " + dir.str());
+  const Result e = hnn("evaluate " + dir.str() + " --json");
   ASSERT_EQ(e.exit_code, 0) << e.out;
   const json evaluated = json_in(e.out);
   for (const char* key : {"train_loss", "test_loss", "energy_mse"})
@@ -195,6 +199,84 @@ TEST(CliEvaluateAndRollout, WorkOnASavedRun) {
   EXPECT_EQ(lines[51].rfind("hnn,0,0,", 0), 0u) << lines[51];
   EXPECT_NE(lines[100].find(",5,"), std::string::npos) << lines[100];  // t_end of trajectory 0
   EXPECT_NE(r.out.find("hnn rollout: 2 trajectories, rk4 -> "), std::string::npos) << r.out;
+}
+
+// Without --json, a few lines a person reads: the run, its losses with standard errors and R²,
+// its rollouts beside the truth's, the energy error absolute and relative, the time, the files.
+TEST(CliTrain, PrintsASummaryNotTheJson) {
+  TempDir dir("run");
+  const Result r = hnn("train spring --steps 20 --hidden 16 16 --out " + dir.str() + " --quiet");
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_EQ(r.out.find('{'), std::string::npos) << r.out;
+  EXPECT_LE(lines_of(r.out).size(), 8u) << r.out;
+  const json m = json::parse(read_text(dir.path() / "metrics.json"));
+  for (const std::string& want :
+       {std::string("spring hnn: seed 0, 20 steps, hidden 16-16, double"),
+        fmt::format("test {:.3g} ± {:.2g}", m["test_loss"].get<double>(),
+                    m["test_loss_se"].get<double>()),
+        fmt::format("R² test {:.4g}", m["test_r2"].get<double>()),
+        std::string("valid prediction time"), std::string("the truth perturbed by 1e-4"),
+        fmt::format("MSE {:.3g} ± {:.2g} against the true H", m["energy_mse"].get<double>(),
+                    m["energy_mse_se"].get<double>()),
+        fmt::format("relative {:.3g}", m["energy_relative_mse"].get<double>()),
+        std::string("training "), std::string("metrics.json, params.bin, rollout.csv")}) {
+    EXPECT_NE(r.out.find(want), std::string::npos) << want << " is not in:\n" << r.out;
+  }
+  // evaluate says what it did: which parameters, on which data, what it wrote.
+  const Result e = hnn("evaluate " + dir.str());
+  ASSERT_EQ(e.exit_code, 0) << e.out;
+  EXPECT_EQ(e.out.find('{'), std::string::npos) << e.out;
+  EXPECT_NE(e.out.find("hnn evaluate: the parameters in " + (dir.path() / "params.bin").string() +
+                       " on its own data (the task's, seed 0)"),
+            std::string::npos)
+      << e.out;
+  EXPECT_NE(e.out.find("wrote      nothing"), std::string::npos) << e.out;
+  const Result written = hnn("evaluate " + dir.str() + " --write");
+  EXPECT_NE(written.out.find("wrote      rollout.csv"), std::string::npos) << written.out;
+}
+
+TEST(CliHelp, HasNoTypeTagsAndStatesDefaultsAndFormats) {
+  const std::regex tag(
+      R"(\b(INT|UINT|UINT64|FLOAT|BOOLEAN)\b|:\{|:(POSITIVE|NONNEGATIVE|DIR|FILE)\b)");
+  for (const std::string& name : subcommands(hnn("--help").out)) {
+    const std::string help = hnn(name + " --help").out;
+    std::smatch m;
+    EXPECT_FALSE(std::regex_search(help, m, tag)) << name << ": '" << m.str() << "' in\n" << help;
+  }
+  const std::string train = hnn("train --help").out;
+  for (const char* want : {"--steps N", "--seed N", "(default: 0)",
+                           "(default: each task's own: 2000 (spring", "150000 (double-pendulum)",
+                           "auto (the default: by trajectories when the file has more "
+                           "than one, else by time)"}) {
+    EXPECT_NE(train.find(want), std::string::npos) << want << " is not in\n" << train;
+  }
+  EXPECT_NE(hnn("simulate --help").out.find("--energy LO:HI"), std::string::npos);
+  const Result version = hnn("--version");
+  EXPECT_EQ(version.exit_code, 0);
+  EXPECT_TRUE(std::regex_match(version.out, std::regex("hnn [0-9]+\\.[0-9]+\\.[0-9]+\n")))
+      << version.out;
+}
+
+// The integrators --help lists are those an unknown one's error lists.
+TEST(CliHelp, ListsTheIntegratorsTheErrorsList) {
+  TempDir dir("simulate");
+  const std::string command = "'" + std::string(HNN_EXE) +
+                              "' simulate --hamiltonian 'p^2/2 + q^2/2' --coords q --momenta p "
+                              "--trajectories 1 --t-end 1 --points 2 --integrator foo --out " +
+                              dir.str() + "/x.csv 2>&1";  // the error, on stderr
+  FILE* pipe = popen(command.c_str(), "r");
+  ASSERT_NE(pipe, nullptr);
+  char buffer[4096];
+  const std::size_t n = fread(buffer, 1, sizeof buffer, pipe);
+  pclose(pipe);
+  const std::string error(buffer, n);
+  const std::size_t known = error.find("known: ");
+  ASSERT_NE(known, std::string::npos) << error;
+  const std::string list = error.substr(known + 7, error.find('\n') - known - 7);
+  for (const char* name : {"simulate", "rollout"}) {
+    const std::string help = hnn(std::string(name) + " --help").out;
+    EXPECT_NE(help.find("One of " + list), std::string::npos) << list << " is not in\n" << help;
+  }
 }
 
 TEST(CliReproduce, WritesTable1WithThePapersValues) {

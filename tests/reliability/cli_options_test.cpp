@@ -195,6 +195,22 @@ TEST(CliOptions, HelpStillExitsZero) {
   EXPECT_NE(r.out.find("--checkpoint-every"), std::string::npos);
 }
 
+// A run that ends no better than it started (here: a learning rate of 1e3) exits 0, as it
+// finished, but says so on the terminal and in metrics.json.
+TEST(CliOptions, ARunThatEndsNoBetterThanItStartedIsWarnedAbout) {
+  const TempDir dir;
+  const Result r = run_hnn({"train", "spring", "--lr", "1e3", "--steps", "30", "--hidden", "8",
+                            "--quiet", "--out", (dir / "run").string()},
+                           dir.path());
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json warnings = read_json(dir / "run" / "metrics.json")["warnings"];
+  ASSERT_FALSE(warnings.empty());
+  for (const auto& warning : warnings) {
+    EXPECT_NE(r.err.find("hnn: warning: " + warning.get<std::string>() + "\n"), std::string::npos)
+        << r.err;
+  }
+}
+
 // ---- the table of `hnn train`'s options (tasks/train_options.h) makes each of its forms -------
 
 using nlohmann::json;
@@ -230,7 +246,12 @@ TEST(TrainOptionsTable, EveryRowIsAnOptionOfHnnTrainUnderItsHeadingWithItsDefaul
                                                             : group)
         << name;
     if (!option.default_shown.empty()) {
-      EXPECT_NE(line.find("=" + std::string(option.default_shown)), std::string::npos) << line;
+      EXPECT_NE(line.find("(default: " + std::string(option.default_shown) + ")"),
+                std::string::npos)
+          << line;
+    }
+    if (option.default_by_task) {
+      EXPECT_NE(line.find("(default: each task's own: "), std::string::npos) << line;
     }
   }
 }

@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <map>
@@ -112,7 +113,22 @@ TEST(DataTask, TrainsOnACsvAndEvaluatesOnHeldOutTrajectories) {
   EXPECT_LT(m["coordinate_mse"].get<double>(), 0.05) << m.dump(1);
   EXPECT_LT(m["learned_h_drift_relative"].get<double>(), 1e-4);  // conserved along its own flow
   EXPECT_TRUE(m["energy_mse"].is_number());
+  // The relative figure beside it: unit-free, and small for a good fit of H near 1.
+  EXPECT_GT(m["energy_relative_mse"].get<double>(), 0);
+  EXPECT_LT(m["energy_relative_mse"].get<double>(), 0.1);
+  EXPECT_TRUE(m["energy_relative_mse_se"].is_number());
   EXPECT_EQ(m["state_names"], nlohmann::json({"q1", "q2", "p1", "p2"}));
+  // The loss watched during training (loss_curve.csv, the progress line) is in metrics.json
+  // under its own name, and "units" says which keys are in which units.
+  const std::vector<std::string> curve = read_lines(dir / "hnn" / "loss_curve.csv");
+  const double watched = std::stod(curve.back().substr(curve.back().rfind(',') + 1));
+  EXPECT_NEAR(m["test_loss_standardised"].get<double>(), watched, 1e-6 * watched);
+  EXPECT_NE(m["test_loss_standardised"], m["test_loss"]);
+  for (const char* key : {"test_loss_standardised", "loss_curve.csv"}) {
+    const nlohmann::json& listed = m["units"]["standardised"];
+    EXPECT_NE(std::find(listed.begin(), listed.end(), key), listed.end()) << key;
+  }
+  EXPECT_NE(m["units"]["file"].get<std::string>().find("test_loss"), std::string::npos);
   const std::vector<std::string> csv = read_lines(dir / "hnn" / "rollout.csv");
   EXPECT_EQ(csv[0], "source,traj,t,q1,q2,p1,p2,energy,learned_h");
   EXPECT_EQ(csv.size(), 1u + 2 * 2 * 25);  // per held-out stretch the data's rows and the hnn's
@@ -171,6 +187,11 @@ TEST(DataTask, AnyScaleGivesTheSameRelativeResults) {
     }
     EXPECT_NEAR(runs[k]["valid_prediction_time"].get<double>(),
                 runs[0]["valid_prediction_time"].get<double>(), 1e-9)
+        << k;
+    // The standardised loss (the progress line's) is the same whatever the file's units.
+    EXPECT_NEAR(runs[k]["test_loss_standardised"].get<double>(),
+                runs[0]["test_loss_standardised"].get<double>(),
+                1e-6 * runs[0]["test_loss_standardised"].get<double>())
         << k;
   }
   EXPECT_NEAR(runs[1]["test_loss"].get<double>() / runs[0]["test_loss"].get<double>(), 1e4, 1e-5);

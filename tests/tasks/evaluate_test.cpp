@@ -293,6 +293,32 @@ TEST(EnergyMse, NoSurvivingTrajectoryGivesNaNNotZero) {
   EXPECT_FALSE(std::isfinite(one.std_error) && one.std_error > 0);
 }
 
+TEST(RelativeEnergyMse, IsTheMseOverTheMeanSquaredTrueEnergyOfTheSameRollouts) {
+  std::vector<double> v;
+  for (int i = 1; i <= 10; ++i) v.push_back(i);
+  Rollouts r = synthetic_rollouts(v, 4);
+  r.true_energy *= 2.0;  // E = 2 on the rollouts: mean E^2 = 4; the errors stay sqrt(v_i)
+  r.pred_energy.array() += 1.0;
+  const nn::MeanStderr mse = energy_mse(r), relative = relative_energy_mse(r);
+  EXPECT_NEAR(mse.mean, 5.5, 1e-12);
+  EXPECT_NEAR(relative.mean, 5.5 / 4, 1e-12);
+  EXPECT_NEAR(relative.std_error, mse.std_error / 4, 1e-12);
+  EXPECT_EQ(relative.count, 10u);
+  // Units cancel: H times 1000 gives the same relative figure.
+  Rollouts scaled = r;
+  scaled.true_energy *= 1000.0;
+  scaled.pred_energy *= 1000.0;
+  EXPECT_NEAR(relative_energy_mse(scaled).mean, relative.mean, 1e-12);
+  // A failed rollout leaves both the MSE and the mean E^2; a true energy of 0 throughout gives
+  // NaN, not infinity.
+  r.failed[9] = true;
+  r.true_energy.row(0).array() = 10.0;
+  const double mean_square = (100.0 + 8 * 4.0) / 9;
+  EXPECT_NEAR(relative_energy_mse(r).mean, energy_mse(r).mean / mean_square, 1e-12);
+  r.true_energy.setZero();
+  EXPECT_TRUE(std::isnan(relative_energy_mse(r).mean));
+}
+
 TEST(CoordinateMse, MeanOverSurvivingTrajectoriesAtEachTime) {
   Rollouts r = synthetic_rollouts({1.0, 1.0, 1.0}, 5);  // pred of trajectory i is i everywhere
   r.pred[1](2, 0) = 3.0;                                // one coordinate off at time 2

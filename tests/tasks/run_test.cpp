@@ -339,5 +339,40 @@ TEST(Table1Markdown, OneRowOfOursAndOneOfThePapersPerTask) {
   EXPECT_NE(with_count.find("| | *paper* (15 rollouts) |"), std::string::npos) << with_count;
 }
 
+// A run that ends no better than it started is warned about, in metrics.json's "warnings".
+TEST(RunWarnings, ALossThatDidNotFallOrAnR2NearZeroIsOneSentenceEach) {
+  const std::vector<CurvePoint> fell = {{20, 1.0, 0.5}, {200, 0.01, 0.02}};
+  const std::vector<CurvePoint> rose = {{20, 1.0, 0.5}, {200, 0.9, 0.6}};
+  EXPECT_TRUE(run_warnings(fell, {{"test_r2", 0.97}}).empty());
+  const std::vector<std::string> warned = run_warnings(rose, {{"test_r2", 0.02}});
+  ASSERT_EQ(warned.size(), 2u);
+  EXPECT_EQ(warned[0],
+            "the test loss did not fall: 0.5 at step 20, 0.6 at the last step (200); the run "
+            "ended no better than it started (a smaller --lr may help)");
+  EXPECT_EQ(warned[1],
+            "the test R^2 is 0.02, below 0.1: the model explains almost none of the spread of the "
+            "test dx/dt");
+  // Without a test loss, the training loss; without an R^2 (the pixel pendulum), the curve only;
+  // without a curve (a run evaluated again), the R^2 only.
+  const std::vector<CurvePoint> no_test = {{1, 1.0, NAN}, {2, 1.0, NAN}};
+  EXPECT_EQ(run_warnings(no_test, json::object()).size(), 1u);
+  EXPECT_NE(run_warnings(no_test, json::object())[0].find("training loss"), std::string::npos);
+  EXPECT_TRUE(run_warnings(fell, {{"test_r2", nullptr}}).empty());
+  EXPECT_EQ(run_warnings({}, {{"test_r2", -3.0}}).size(), 1u);
+}
+
+// A diverging run (a learning rate of 1e3) ends with its warning in metrics.json; a good one
+// with an empty list.
+TEST(RunWarnings, ReachMetricsJson) {
+  TempDir dir("warnings");
+  RunOptions o = testing::small_run("spring", "hnn", dir / "wild", 30);
+  o.learning_rate = 1e3;
+  const json wild = run_training(o);
+  EXPECT_FALSE(wild["warnings"].empty()) << wild.dump(1);
+  EXPECT_EQ(read_json(dir / "wild" / "metrics.json")["warnings"], wild["warnings"]);
+  o = testing::small_run("spring", "hnn", dir / "calm", 200);
+  EXPECT_EQ(run_training(o)["warnings"], json::array()) << "a healthy run was warned about";
+}
+
 }  // namespace
 }  // namespace hnn::tasks

@@ -3,9 +3,11 @@
 // `hnn reversibility` (forward-then-backward integration of any run's learned field).
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "apps/hnn/commands/commands.h"
 #include "apps/hnn/commands/validators.h"
+#include "physics/integrator.h"
 #include "tasks/experiments/pixel_pendulum.h"
 #include "tasks/pixel/bump.h"
 #include "tasks/run.h"
@@ -108,7 +110,9 @@ void add_reversibility_command(CLI::App& app) {
   cmd->add_option("--report", *report,
                   "A results folder of `hnn reproduce`: every run, and reversibility.md")
       ->check(CLI::ExistingDirectory);
-  cmd->add_option("--integrators", o->integrators, "Comma-separated integrators")
+  cmd->add_option("--integrators", o->integrators,
+                  fmt::format("Comma-separated integrators, of {}",
+                              fmt::join(physics::integrator_names(), ", ")))
       ->delimiter(',')
       ->capture_default_str();
   cmd->add_option("--t-end", o->t_end, "Span (default: the task's rollout span)")

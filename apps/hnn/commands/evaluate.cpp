@@ -1,17 +1,33 @@
-// `hnn evaluate`: the metrics of a run folder's saved parameters, again.
+// `hnn evaluate`: the metrics of a run folder's saved parameters, again; says which run, on
+// which data, and what it wrote.
 
 #include <fmt/format.h>
 
 #include "apps/hnn/commands/commands.h"
+#include "apps/hnn/commands/summary.h"
 #include "tasks/run.h"
 
 namespace hnn::app {
+
+namespace {
+
+// "on its own data (seed 0)", "on data/pend.csv (its own)", "on other.csv (--data)".
+std::string data_evaluated(const nlohmann::json& m, const std::string& data) {
+  if (!data.empty()) return fmt::format("on {} (--data)", data);
+  const auto file = m.find("data_file");
+  if (file != m.end() && file->is_string() && !file->get<std::string>().empty())
+    return fmt::format("on {} (its own data file)", file->get<std::string>());
+  return fmt::format("on its own data (the task's, seed {})", m.value("seed", 0ULL));
+}
+
+}  // namespace
 
 void add_evaluate_command(CLI::App& app) {
   auto* cmd = app.add_subcommand("evaluate", "Evaluate the saved parameters of a run folder");
   auto dir = std::make_shared<std::string>();
   auto data = std::make_shared<std::string>();
   auto write = std::make_shared<bool>(false);
+  auto json = std::make_shared<bool>(false);
   cmd->add_option("run", *dir, "Run folder written by `hnn train`")
       ->required()
       ->check(CLI::ExistingDirectory);
@@ -20,10 +36,24 @@ void add_evaluate_command(CLI::App& app) {
                   "of the same format, or the run's own at a new place (its SHA-256 is not "
                   "checked)")
       ->check(CLI::ExistingFile);
-  cmd->add_flag("--write", *write, "Also rewrite the run's rollout.csv and evaluation.json");
+  cmd->add_flag("--write", *write,
+                "Also rewrite the run's evaluation files (rollout.csv and the task's own)");
+  cmd->add_flag("--json", *json, "Print the metrics as JSON on stdout instead of the summary");
   cmd->callback([=] {
+    const auto start = std::filesystem::file_time_type::clock::now();
     const nlohmann::json m = tasks::evaluate_run(*dir, *data, *write);
-    fmt::print("{}\n", m.dump(2));
+    if (*json) {
+      fmt::print("{}\n", m.dump(2));
+    } else {
+      const std::string written = *write ? files_in(*dir, start) : "";
+      fmt::print("hnn evaluate: the parameters in {} {}\n{}  wrote      {}\n",
+                 (std::filesystem::path(*dir) / "params.bin").string(), data_evaluated(m, *data),
+                 metrics_summary(m),
+                 written.empty() ? "nothing (metrics.json is as training left it; --write "
+                                   "rewrites the evaluation files)"
+                                 : written);
+    }
+    print_warnings(m);
   });
 }
 

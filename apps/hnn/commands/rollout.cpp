@@ -3,9 +3,11 @@
 // CSV (tasks/report/rollout_csv.h).
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "apps/hnn/commands/commands.h"
 #include "apps/hnn/commands/validators.h"
+#include "physics/integrator.h"
 #include "tasks/run.h"
 
 namespace hnn::app {
@@ -28,7 +30,7 @@ void add_rollout_command(CLI::App& app) {
       ->required()
       ->check(CLI::ExistingDirectory);
   cmd->add_option("--integrator", o->command.request.integrator,
-                  "euler, rk4, dopri5, leapfrog, yoshida4, midpoint")
+                  fmt::format("One of {}", fmt::join(physics::integrator_names(), ", ")))
       ->capture_default_str();
   cmd->add_option("--dt", o->command.request.dt, "Step of fixed-step integrators")
       ->check(positive_real())

@@ -4,6 +4,7 @@
 #include "physics/simulate.h"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <optional>
 #include <set>
@@ -12,6 +13,7 @@
 #include "apps/hnn/commands/validators.h"
 #include "nn/atomic_file.h"
 #include "physics/expression_system.h"
+#include "physics/integrator.h"
 
 namespace hnn::app {
 
@@ -148,11 +150,14 @@ void add_simulate_command(CLI::App& app) {
   auto o = std::make_shared<SimulateOptions>();
   cmd->add_option("--hamiltonian", o->hamiltonian,
                   "H as an expression, e.g. \"p^2/2 + 9.81*(1 - cos(q))\"")
+      ->option_text("EXPR")
       ->required();
   cmd->add_option("--coords", o->coords, "Coordinate names, in order (repeat or comma-separate)")
+      ->option_text("NAME ...")
       ->required()
       ->delimiter(',');
   cmd->add_option("--momenta", o->momenta, "Momentum names, one per coordinate")
+      ->option_text("NAME ...")
       ->required()
       ->delimiter(',');
   cmd->add_option("--trajectories", o->trajectories, "Trajectories")
@@ -168,8 +173,10 @@ void add_simulate_command(CLI::App& app) {
       ->check(non_negative_real())
       ->capture_default_str();
   cmd->add_option("--integrator", o->integrator,
-                  "dopri5, rk4, midpoint, leapfrog, yoshida4, symplectic_euler, euler "
-                  "(splitting methods need a separable H)")
+                  fmt::format("One of {} (the splitting methods leapfrog, yoshida4 and "
+                              "symplectic_euler need a separable H)",
+                              fmt::join(physics::integrator_names(), ", ")))
+      ->option_text("NAME")
       ->capture_default_str();
   cmd->add_option("--dt", o->dt, "Step of fixed-step integrators")
       ->check(positive_real())
@@ -181,9 +188,12 @@ void add_simulate_command(CLI::App& app) {
       ->check(seed_value())
       ->capture_default_str();
   cmd->add_option("--sample", o->sample,
-                  "Initial-state box, e.g. \"q=-1:1,p=-1:1\" (unnamed variables: -1:1)");
-  cmd->add_option("--energy", o->energy, "Keep only initial states with LO <= H <= HI");
-  cmd->add_option("--out", o->out, "CSV file to write")->required();
+                  "Initial-state box, e.g. \"q=-1:1,p=-1:1\" (unnamed variables: -1:1)")
+      ->option_text("NAME=LO:HI,...");
+  cmd->add_option("--energy", o->energy,
+                  "Keep only initial states with LO <= H <= HI, given as LO:HI (e.g. 0.5:2)")
+      ->option_text("LO:HI");
+  cmd->add_option("--out", o->out, "CSV file to write")->option_text("FILE")->required();
   cmd->callback([o] { simulate(*o); });
 }
 

@@ -2,17 +2,20 @@
 // with a checkpoint.
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <csignal>
 #include <cstdint>
 #include <cstdio>
+#include <memory>
 #include <optional>
 #include <span>
 #include <vector>
 
 #include "apps/hnn/commands/commands.h"
+#include "apps/hnn/commands/summary.h"
 #include "apps/hnn/commands/validators.h"
 #include "tasks/experiments/registry.h"
 #include "tasks/run.h"
@@ -56,8 +59,12 @@ void train_until_done_or_stopped(tasks::RunOptions o) {
   o.stop = &g_stop;
   try {
     const nlohmann::json m = tasks::run_training(o);
-    fmt::print("{}\n", m.dump(2));
-    fmt::print(stderr, "hnn train: results in {}\n", o.out.string());
+    if (o.print_json) {
+      fmt::print("{}\n", m.dump(2));
+    } else {
+      fmt::print("{}  files      {}: {}\n", metrics_summary(m), o.out.string(), files_in(o.out));
+    }
+    print_warnings(m);
   } catch (const tasks::TrainingInterrupted& e) {
     fmt::print(stderr, "hnn: {}\nhnn: resume with: hnn train --resume {}\n", e.what(),
                o.out.string());
@@ -87,14 +94,77 @@ nlohmann::json task_settings(const std::string& text) {
   return j;
 }
 
+// "2000 (spring, pendulum), 10000 (two-body)": each task's own value of `option`, as a run of
+// the task alone records it.
+std::string defaults_by_task(const tasks::TrainOption& option) {
+  std::vector<std::pair<std::string, std::string>> groups;  // a value and its tasks
+  for (const std::string& name : tasks::task_names()) {
+    const std::unique_ptr<tasks::Task> task = tasks::make_task(name);
+    const tasks::RunOptions alone{.task = name, .model = task->models().front()};
+    const nlohmann::json value = tasks::resolve(*task, alone).to_json().at(std::string(option.key));
+    const std::string text = value.is_string() ? value.get<std::string>() : value.dump();
+    const auto group =
+        std::find_if(groups.begin(), groups.end(), [&](const auto& g) { return g.first == text; });
+    if (group == groups.end()) {
+      groups.emplace_back(text, name);
+    } else {
+      group->second += ", " + name;
+    }
+  }
+  std::string out;
+  for (const auto& [value, names] : groups)
+    out += fmt::format("{}{} ({})", out.empty() ? "" : ", ", value, names);
+  return out;
+}
+
+// --help's text of `option`: its "{}" filled with the tasks or the choices, and its default.
+std::string help_text(const tasks::TrainOption& option) {
+  std::string help(option.help);
+  if (option.kind == tasks::ValueKind::kTask) help = fmt::format(fmt::runtime(help), task_list());
+  if (option.kind == tasks::ValueKind::kChoice && help.find("{}") != std::string::npos)
+    help = fmt::format(fmt::runtime(help), fmt::join(option.choices(), ", "));
+  if (option.default_by_task)
+    help += fmt::format(" (default: each task's own: {})", defaults_by_task(option));
+  return help;
+}
+
+// What --help shows after an option's name (HelpFormatter, help_format.h).
+std::string placeholder(tasks::ValueKind kind) {
+  using tasks::ValueKind;
+  switch (kind) {
+    case ValueKind::kChoice:
+      return "NAME";
+    case ValueKind::kSeed:
+    case ValueKind::kInt:
+      return "N";
+    case ValueKind::kHidden:
+      return "N ...";
+    case ValueKind::kPositiveReal:
+    case ValueKind::kFraction:
+      return "X";
+    case ValueKind::kFile:
+      return "FILE";
+    case ValueKind::kFolder:
+    case ValueKind::kRunFolder:
+      return "DIR";
+    case ValueKind::kJsonObject:
+      return "JSON";
+    case ValueKind::kColumns:
+      return "COLUMNS";
+    case ValueKind::kText:
+      return "TEXT";
+    default:  // the positional TASK, a flag
+      return "";
+  }
+}
+
 // `option` on the command line, bound to `given` and checked by its kind.
 CLI::Option* add_option(CLI::App& cmd, const tasks::TrainOption& option, Given& given) {
   using tasks::ValueKind;
-  if (option.kind == ValueKind::kTask) {
-    return cmd.add_option(std::string(option.name), given.text,
-                          fmt::format(fmt::runtime(option.help), task_list()));
-  }
-  const std::string name = "--" + std::string(option.name), help(option.help);
+  const std::string help = help_text(option);
+  if (option.kind == ValueKind::kTask)
+    return cmd.add_option(std::string(option.name), given.text, help);
+  const std::string name = "--" + std::string(option.name);
   switch (option.kind) {
     case ValueKind::kFlag:
       return cmd.add_flag(name, given.flag, help);
@@ -199,6 +269,7 @@ void add_train_command(CLI::App& app) {
   auto given = std::make_shared<std::vector<Given>>(table.size());
   for (std::size_t i = 0; i < table.size(); ++i) {
     CLI::Option* option = add_option(*cmd, table[i], (*given)[i]);
+    option->option_text(placeholder(table[i].kind));
     if (!table[i].group.empty()) option->group(std::string(table[i].group));
     if (!table[i].default_shown.empty()) option->default_str(std::string(table[i].default_shown));
   }

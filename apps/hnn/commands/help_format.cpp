@@ -1,0 +1,41 @@
+#include "apps/hnn/commands/help_format.h"
+
+namespace hnn::app {
+
+namespace {
+
+// The placeholder of an option's value, from CLI11's type name ("INT:INT", "TEXT:{a,b}",
+// "TEXT:DIR"): what it takes, without the tag.
+std::string value_placeholder(const CLI::Option* opt) {
+  const std::string type = opt->get_type_name();
+  const std::string base = type.substr(0, type.find(':'));
+  if (type.find(":DIR") != std::string::npos) return "DIR";
+  if (type.find(":FILE") != std::string::npos) return "FILE";
+  if (type.find(":{") != std::string::npos) return "NAME";
+  if (base == "INT" || base == "UINT") return "N";
+  if (base == "FLOAT") return "X";
+  return "TEXT";
+}
+
+}  // namespace
+
+std::string HelpFormatter::make_option_opts(const CLI::Option* opt) const {
+  std::string out;
+  if (!opt->get_option_text().empty()) {
+    out = " " + opt->get_option_text();
+  } else if (opt->get_type_size() != 0 && !opt->get_type_name().empty() && opt->nonpositional()) {
+    out = " " + value_placeholder(opt);
+    if (opt->get_expected_max() >= CLI::detail::expected_max_vector_size) out += " ...";
+  }
+  if (opt->get_required()) out += " " + get_label("REQUIRED");
+  return out;
+}
+
+std::string HelpFormatter::make_option_desc(const CLI::Option* opt) const {
+  const std::string& description = opt->get_description();
+  const std::string& shown = opt->get_default_str();
+  if (shown.empty() || description.find("(default") != std::string::npos) return description;
+  return description + " (default: " + shown + ")";
+}
+
+}  // namespace hnn::app

@@ -1,0 +1,18 @@
+#pragma once
+// --help without CLI11's type tags ("--steps INT:INT", "--seed UINT:UINT64"): an option shows a
+// placeholder for its value (its own option_text, else N for an integer, X for a number, NAME for
+// one of a list, FILE, DIR or TEXT) and its default after its help as "(default: ...)".
+
+#include <CLI/CLI.hpp>
+#include <string>
+
+namespace hnn::app {
+
+class HelpFormatter : public CLI::Formatter {
+ public:
+  HelpFormatter() { column_width(28); }
+  std::string make_option_opts(const CLI::Option* opt) const override;
+  std::string make_option_desc(const CLI::Option* opt) const override;
+};
+
+}  // namespace hnn::app

@@ -1,0 +1,133 @@
+// The few lines `hnn train` and `hnn evaluate` print (summary.h), from metrics.json's keys: each
+// line is left out when a task has no such key (the pixel pendulum has no R^2, a data run without
+// a known H no energy MSE).
+
+#include "apps/hnn/commands/summary.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <optional>
+#include <utility>
+#include <vector>
+
+namespace hnn::app {
+
+namespace {
+
+using nlohmann::json;
+
+std::optional<double> number_at(const json& m, const std::string& key) {
+  const auto it = m.find(key);
+  if (it == m.end() || !it->is_number()) return std::nullopt;
+  return it->get<double>();
+}
+
+// "3.12e-02 ± 1.1e-03" (the key and its "_se"), or "" when the run has no such number.
+std::string with_se(const json& m, const std::string& key) {
+  const std::optional<double> value = number_at(m, key);
+  if (!value) return "";
+  const std::optional<double> se = number_at(m, key + "_se");
+  return se ? fmt::format("{:.3g} ± {:.2g}", *value, *se) : fmt::format("{:.3g}", *value);
+}
+
+std::string text_at(const json& m, const std::string& key) {
+  const auto it = m.find(key);
+  if (it == m.end()) return "";
+  return it->is_string() ? it->get<std::string>() : it->dump();
+}
+
+// "spring hnn: seed 0, 2000 steps, hidden 200-200, double".
+std::string heading_line(const json& m) {
+  return fmt::format("{} {}: seed {}, {} steps, hidden {}, {}", text_at(m, "task"),
+                     text_at(m, "model"), text_at(m, "seed"), text_at(m, "steps"),
+                     text_at(m, "hidden"), text_at(m, "dtype"));
+}
+
+// "  loss     test 3.1e-02 ± 1e-03, train 3e-02 ± 1e-03; R² test 0.998, train 0.999".
+std::string loss_lines(const json& m) {
+  std::string line = fmt::format("  loss       test {}, train {}", with_se(m, "test_loss"),
+                                 with_se(m, "train_loss"));
+  if (const auto r2 = number_at(m, "test_r2")) {
+    line += fmt::format("; R² test {:.4g}", *r2);
+    if (const auto train = number_at(m, "train_r2")) line += fmt::format(", train {:.4g}", *train);
+  }
+  line += "\n";
+  if (m.contains("test_loss_standardised")) {
+    line += fmt::format(
+        "             in the data file's units; in standardised units (the progress line's and "
+        "loss_curve.csv's): test {}, train {}\n",
+        with_se(m, "test_loss_standardised"), with_se(m, "train_loss_standardised"));
+  }
+  return line;
+}
+
+// The valid prediction time, beside the truth's own (perturbed by 1e-4) where known.
+std::string prediction_line(const json& m) {
+  const std::string valid = with_se(m, "valid_prediction_time");
+  if (valid.empty()) return "";
+  std::string line = fmt::format("  rollouts   valid prediction time {}", valid);
+  if (const auto threshold = number_at(m, "valid_prediction_threshold"))
+    line += fmt::format(" (until the relative state error passes {:g})", *threshold);
+  if (const auto floor = number_at(m, "valid_prediction_time_floor"))
+    line += fmt::format("; the truth perturbed by 1e-4: {:.3g}", *floor);
+  return line + "\n";
+}
+
+// The energy error against the true H: absolute and relative; or why there is none.
+std::string energy_lines(const json& m) {
+  std::string out;
+  if (const std::string mse = with_se(m, "energy_mse"); !mse.empty()) {
+    out += fmt::format("  energy     MSE {} against the true H", mse);
+    if (const std::string relative = with_se(m, "energy_relative_mse"); !relative.empty())
+      out += fmt::format(", relative {} (MSE / mean true E²)", relative);
+    out += "\n";
+  } else if (m.contains("energy_note")) {
+    out += fmt::format("  energy     {}\n", text_at(m, "energy_note"));
+  }
+  if (const std::string end = with_se(m, "energy_error_end"); !end.empty())
+    out += fmt::format("  energy     error at the end {} (the LNN paper's metric)\n", end);
+  return out;
+}
+
+std::string timing_line(const json& m) {
+  constexpr std::pair<const char*, const char*> kTimes[] = {
+      {"train_seconds", "training"}, {"data_seconds", "data"}, {"eval_seconds", "evaluation"}};
+  std::vector<std::string> parts;
+  for (const auto& [key, name] : kTimes) {
+    if (const auto s = number_at(m, key)) parts.push_back(fmt::format("{} {:.1f} s", name, *s));
+  }
+  if (parts.empty()) return "";
+  std::string line = "  time      ";
+  for (std::size_t i = 0; i < parts.size(); ++i) line += (i ? ", " : " ") + parts[i];
+  return line + "\n";
+}
+
+}  // namespace
+
+std::string metrics_summary(const json& m) {
+  return heading_line(m) + "\n" + loss_lines(m) + prediction_line(m) + energy_lines(m) +
+         timing_line(m);
+}
+
+void print_warnings(const json& metrics) {
+  const auto it = metrics.find("warnings");
+  if (it == metrics.end() || !it->is_array()) return;
+  for (const json& warning : *it)
+    fmt::print(stderr, "hnn: warning: {}\n", warning.get<std::string>());
+}
+
+std::string files_in(const std::filesystem::path& dir, std::filesystem::file_time_type since) {
+  std::vector<std::string> names;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    if (entry.is_regular_file() && entry.last_write_time() >= since)
+      names.push_back(entry.path().filename().string());
+  }
+  std::sort(names.begin(), names.end());
+  std::string out;
+  for (const std::string& name : names) out += (out.empty() ? "" : ", ") + name;
+  return out;
+}
+
+}  // namespace hnn::app
