@@ -32,7 +32,7 @@ class RunChartsTest(unittest.TestCase):
         build_results(results)
         cls.base, cls.hnn = (os.path.join(results, "spring", m) for m in ("baseline", "hnn"))
         for model, run in (("baseline", cls.base), ("hnn", cls.hnn)):  # `hnn rollout`'s files
-            write_rollout(os.path.join(run, "rollout_dopri5.csv"), *spring_rollouts(model))
+            write_rollout(os.path.join(run, "rollout_dopri5.csv"), *spring_rollouts(model), model)
 
     @classmethod
     def tearDownClass(cls):
@@ -85,7 +85,7 @@ class RunChartsTest(unittest.TestCase):
         t, trajs = spring_rollouts("hnn")
         path = os.path.join(self.root, "no_truth", "rollout.csv")
         os.makedirs(os.path.dirname(path))
-        write_rollout(path, t, [(x, y, None, None, h) for x, y, _, _, h in trajs])
+        write_rollout(path, t, [(x, y, None, None, h) for x, y, _, _, h in trajs], "hnn")
         out = os.path.join(self.root, "no_truth_out")
         run = self.plot("--rollouts", path, "--out", out)
         self.assertEqual(run.returncode, 0, run.stderr)

@@ -66,7 +66,7 @@ MeasuredData split_trajectories(const MeasuredTrajectories& trajectories, const 
 
 struct MeasuredDataOptions {
   ColumnChoice columns;
-  SplitChoice split;
+  SplitChoice split{};
 };
 
 /// read_table, select_trajectories, split_trajectories.

@@ -72,8 +72,6 @@ std::vector<nn::Matrix<T>> values_of(const nn::Module<T>& m) {
   return values;
 }
 
-}  // namespace
-
 TEST_F(ParameterFile, SaveThenLoadReproducesPredictionsBitForBit) {
   std::mt19937_64 rng(1), other(2);
   const MatrixD x = nn::random_normal<double>(16, 2, rng);
@@ -228,3 +226,5 @@ TEST_F(ParameterFile, SavesSeveralModulesTogether) {
   expect_refusal([&] { nn::save_parameters<float>(file("dup.bin"), "x", duplicated); },
                  file("dup.bin"), "duplicate parameter name 'encoder.0.weight'");
 }
+
+}  // namespace

@@ -32,7 +32,7 @@ class DerivativeColumns : public testing::DataFilesTest {
 class NpzTrajectories : public testing::DataFilesTest {};
 
 TEST_F(CsvLayouts, SemicolonsAndTabsSeparateWhenTheHeaderUsesThem) {
-  for (const std::string& sep : {";", "\t"}) {
+  for (const std::string sep : {";", "\t"}) {
     const std::string text = "t" + sep + "q" + sep + "p\n0" + sep + "1.5" + sep + "2\n";
     const Table table = read_table(write("s.csv", text));
     EXPECT_EQ(table.names, (Names{"t", "q", "p"}));

@@ -107,7 +107,9 @@ void expect_rollout_csv(const fs::path& path, const TaskShape& shape, const std:
     ASSERT_EQ(cells[0], truth ? "true" : model) << "line " << i;
     ASSERT_EQ(std::stoi(cells[1]), int(block / 2)) << "line " << i;
     EXPECT_NEAR(std::stod(cells[2]), shape.t_end * double(k) / double(points - 1), 1e-6) << i;
-    if (truth) EXPECT_FALSE(cells[3 + std::size_t(shape.dim)].empty()) << "energy, line " << i;
+    if (truth) {
+      EXPECT_FALSE(cells[3 + std::size_t(shape.dim)].empty()) << "energy, line " << i;
+    }
     if (truth || model != "hnn") {
       EXPECT_TRUE(cells.back().empty()) << "learned_h of the truth or a baseline, line " << i;
     } else if (!cells[3].empty()) {  // a prediction: its H too
