@@ -1,6 +1,23 @@
 #include "apps/hnn/commands/help_format.h"
 
+#include <utility>
+
 namespace hnn::app {
+
+std::string text_placeholder(std::string_view name) {
+  static const std::pair<const char*, const char*> kByName[] = {
+      {"out", "PATH"},          {"data", "FILE"},          {"states", "FILE"},
+      {"hamiltonian", "EXPR"},  {"state", "V0,V1,.."},     {"scheduler", "ADDRESS"},
+      {"time", "COLUMN"},       {"trajectory", "COLUMN"},  {"coords", "COLUMNS"},
+      {"momenta", "COLUMNS"},   {"velocities", "COLUMNS"}, {"derivatives", "COLUMNS"},
+      {"tasks", "NAMES"},       {"models", "NAMES"},       {"loss", "NAMES"},
+      {"integrators", "NAMES"}, {"integrator", "NAME"},    {"format", "NAME"},
+      {"settings", "JSON"},     {"sample", "BOX"},         {"energy", "LO:HI"}};
+  for (const auto& [option, placeholder] : kByName) {
+    if (name == option) return placeholder;
+  }
+  return "TEXT";
+}
 
 namespace {
 
@@ -14,7 +31,7 @@ std::string value_placeholder(const CLI::Option* opt) {
   if (type.find(":{") != std::string::npos) return "NAME";
   if (base == "INT" || base == "UINT") return "N";
   if (base == "FLOAT") return "X";
-  return "TEXT";
+  return text_placeholder(opt->get_single_name());
 }
 
 }  // namespace

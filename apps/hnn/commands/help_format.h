@@ -5,8 +5,13 @@
 
 #include <CLI/CLI.hpp>
 #include <string>
+#include <string_view>
 
 namespace hnn::app {
+
+/// A free-text option's placeholder, by what the option (named without dashes) takes: PATH, FILE,
+/// EXPR, COLUMN, NAMES, ... rather than CLI11's TEXT.
+std::string text_placeholder(std::string_view name);
 
 class HelpFormatter : public CLI::Formatter {
  public:

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "apps/hnn/commands/commands.h"
+#include "apps/hnn/commands/help_format.h"
 #include "apps/hnn/commands/summary.h"
 #include "apps/hnn/commands/validators.h"
 #include "tasks/experiments/registry.h"
@@ -129,9 +130,9 @@ std::string help_text(const tasks::TrainOption& option) {
 }
 
 // What --help shows after an option's name (HelpFormatter, help_format.h).
-std::string placeholder(tasks::ValueKind kind) {
+std::string placeholder(const tasks::TrainOption& option) {
   using tasks::ValueKind;
-  switch (kind) {
+  switch (option.kind) {
     case ValueKind::kChoice:
       return "NAME";
     case ValueKind::kSeed:
@@ -152,7 +153,7 @@ std::string placeholder(tasks::ValueKind kind) {
     case ValueKind::kColumns:
       return "COLUMNS";
     case ValueKind::kText:
-      return "TEXT";
+      return text_placeholder(option.name);
     default:  // the positional TASK, a flag
       return "";
   }
@@ -269,7 +270,7 @@ void add_train_command(CLI::App& app) {
   auto given = std::make_shared<std::vector<Given>>(table.size());
   for (std::size_t i = 0; i < table.size(); ++i) {
     CLI::Option* option = add_option(*cmd, table[i], (*given)[i]);
-    option->option_text(placeholder(table[i].kind));
+    option->option_text(placeholder(table[i]));
     if (!table[i].group.empty()) option->group(std::string(table[i].group));
     if (!table[i].default_shown.empty()) option->default_str(std::string(table[i].default_shown));
   }
