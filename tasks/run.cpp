@@ -287,8 +287,9 @@ RolloutWritten write_rollout(const fs::path& run_dir, const RolloutCommand& comm
   return {.path = path, .trajectories = output.trajectories, .notes = std::move(output.notes)};
 }
 
-json reversibility(const fs::path& run_dir, const ReversibilityOptions& options) {
-  const LoadedRun loaded = load_run(run_dir);
+json reversibility(const fs::path& run_dir, const ReversibilityOptions& options,
+                   const std::string& data_file) {
+  const LoadedRun loaded = load_run(run_dir, data_file);
   ReversibilityOptions o = options;
   if (o.t_end <= 0) o.t_end = loaded.run->rollout_span();
   json result =

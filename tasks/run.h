@@ -95,9 +95,11 @@ struct RolloutWritten {
 RolloutWritten write_rollout(const std::filesystem::path& run_dir, const RolloutCommand& command);
 
 /// Reversibility of a run's learned field from its rollout states (t_end 0: the run's rollout
-/// span); writes run_dir/reversibility.json and returns it.
+/// span); writes run_dir/reversibility.json and returns it. `data_file`: the run's own data file
+/// at a new place (load_run's kRunsOwn: its SHA-256 must be the run's).
 nlohmann::json reversibility(const std::filesystem::path& run_dir,
-                             const ReversibilityOptions& options = {});
+                             const ReversibilityOptions& options = {},
+                             const std::string& data_file = "");
 
 /// The options of the run in `run_dir`, read from its last checkpoint, with resume set: passed
 /// to run_training, it continues that run and ends as the uninterrupted run would have. With

@@ -103,6 +103,7 @@ TEST_F(RunsTravel, AMovedDataFileIsFoundWithDataAndAnotherFileIsRefused) {
   for (const std::vector<std::string>& args :
        {std::vector<std::string>{"evaluate", run.string()},
         {"export", run.string(), "--format", "c", "--out", (dir_ / "b.c").string()},
+        {"reversibility", run.string(), "--trajectories", "2"},
         {"train", "--resume", run.string(), "--quiet"}}) {
     const Result r = from_root(args);
     EXPECT_EQ(r.code, 1) << args[0];
@@ -113,6 +114,14 @@ TEST_F(RunsTravel, AMovedDataFileIsFoundWithDataAndAnotherFileIsRefused) {
   ASSERT_EQ(exported.code, 0) << exported.err;
   EXPECT_EQ(read_text(dir_ / "b.c"), read_text(dir_ / "a.c"));
   EXPECT_EQ(from_root({"evaluate", run.string(), "--data", moved.string()}).code, 0);
+  const Result reversed =
+      from_root({"reversibility", run.string(), "--trajectories", "2", "--data", moved.string()});
+  EXPECT_EQ(reversed.code, 0) << reversed.err;
+  EXPECT_TRUE(fs::exists(run / "reversibility.json"));
+  const Result two =
+      from_root({"reversibility", run.string(), run.string(), "--data", moved.string()});
+  EXPECT_EQ(two.code, 1);
+  EXPECT_NE(two.err.find("names the data file of one run folder"), std::string::npos) << two.err;
 
   // Another file in its place: the last digit of the first row changed.
   std::string text = read_text(moved);

@@ -106,7 +106,12 @@ void add_reversibility_command(CLI::App& app) {
   auto runs = std::make_shared<std::vector<std::string>>();
   auto report = std::make_shared<std::string>();
   auto o = std::make_shared<tasks::ReversibilityOptions>();
+  auto data = std::make_shared<std::string>();
   cmd->add_option("runs", *runs, "Run folders")->check(CLI::ExistingDirectory);
+  cmd->add_option("--data", *data,
+                  "The run's own data file at a new place (one run folder; a file whose SHA-256 "
+                  "differs from the run's is refused)")
+      ->check(CLI::ExistingFile);
   cmd->add_option("--report", *report,
                   "A results folder of `hnn reproduce`: every run, and reversibility.md")
       ->check(CLI::ExistingDirectory);
@@ -127,8 +132,11 @@ void add_reversibility_command(CLI::App& app) {
     if (runs->empty() && report->empty()) {
       throw CLI::ValidationError("reversibility", "give run folders or --report RESULTS");
     }
+    if (!data->empty() && (runs->size() != 1 || !report->empty())) {
+      throw CLI::ValidationError("--data", "names the data file of one run folder");
+    }
     for (const std::string& run : *runs) {
-      fmt::print("{}\n", tasks::reversibility(run, *o).dump(2));
+      fmt::print("{}\n", tasks::reversibility(run, *o, *data).dump(2));
     }
     if (!report->empty()) {
       tasks::reversibility_report(*report, *o);
