@@ -4,7 +4,7 @@
 
 namespace hnn::app {
 
-std::string text_placeholder(std::string_view name) {
+std::string text_metavar(std::string_view name) {
   static const std::pair<const char*, const char*> kByName[] = {
       {"out", "PATH"},          {"data", "FILE"},          {"states", "FILE"},
       {"hamiltonian", "EXPR"},  {"state", "V0,V1,.."},     {"scheduler", "ADDRESS"},
@@ -13,17 +13,17 @@ std::string text_placeholder(std::string_view name) {
       {"tasks", "NAMES"},       {"models", "NAMES"},       {"loss", "NAMES"},
       {"integrators", "NAMES"}, {"integrator", "NAME"},    {"format", "NAME"},
       {"settings", "JSON"},     {"sample", "BOX"},         {"energy", "LO:HI"}};
-  for (const auto& [option, placeholder] : kByName) {
-    if (name == option) return placeholder;
+  for (const auto& [option, metavar] : kByName) {
+    if (name == option) return metavar;
   }
   return "TEXT";
 }
 
 namespace {
 
-// The placeholder of an option's value, from CLI11's type name ("INT:INT", "TEXT:{a,b}",
+// The metavar of an option's value, from CLI11's type name ("INT:INT", "TEXT:{a,b}",
 // "TEXT:DIR"): what it takes, without the tag.
-std::string value_placeholder(const CLI::Option* opt) {
+std::string value_metavar(const CLI::Option* opt) {
   const std::string type = opt->get_type_name();
   const std::string base = type.substr(0, type.find(':'));
   if (type.find(":DIR") != std::string::npos) return "DIR";
@@ -31,7 +31,7 @@ std::string value_placeholder(const CLI::Option* opt) {
   if (type.find(":{") != std::string::npos) return "NAME";
   if (base == "INT" || base == "UINT") return "N";
   if (base == "FLOAT") return "X";
-  return text_placeholder(opt->get_single_name());
+  return text_metavar(opt->get_single_name());
 }
 
 }  // namespace
@@ -41,7 +41,7 @@ std::string HelpFormatter::make_option_opts(const CLI::Option* opt) const {
   if (!opt->get_option_text().empty()) {
     out = " " + opt->get_option_text();
   } else if (opt->get_type_size() != 0 && !opt->get_type_name().empty() && opt->nonpositional()) {
-    out = " " + value_placeholder(opt);
+    out = " " + value_metavar(opt);
     if (opt->get_expected_max() >= CLI::detail::expected_max_vector_size) out += " ...";
   }
   if (opt->get_required()) out += " " + get_label("REQUIRED");

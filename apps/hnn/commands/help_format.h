@@ -1,6 +1,6 @@
 #pragma once
 // --help without CLI11's type tags ("--steps INT:INT", "--seed UINT:UINT64"): an option shows a
-// placeholder for its value (its own option_text, else N for an integer, X for a number, NAME for
+// metavar for its value (its own option_text, else N for an integer, X for a number, NAME for
 // one of a list, FILE, DIR or TEXT) and its default after its help as "(default: ...)".
 
 #include <CLI/CLI.hpp>
@@ -9,9 +9,9 @@
 
 namespace hnn::app {
 
-/// A free-text option's placeholder, by what the option (named without dashes) takes: PATH, FILE,
-/// EXPR, COLUMN, NAMES, ... rather than CLI11's TEXT.
-std::string text_placeholder(std::string_view name);
+/// A free-text option's metavar (the word --help shows for its value), by what the option (named
+/// without dashes) takes: PATH, FILE, EXPR, COLUMN, NAMES, ... rather than CLI11's TEXT.
+std::string text_metavar(std::string_view name);
 
 class HelpFormatter : public CLI::Formatter {
  public:

@@ -130,7 +130,7 @@ std::string help_text(const tasks::TrainOption& option) {
 }
 
 // What --help shows after an option's name (HelpFormatter, help_format.h).
-std::string placeholder(const tasks::TrainOption& option) {
+std::string metavar(const tasks::TrainOption& option) {
   using tasks::ValueKind;
   switch (option.kind) {
     case ValueKind::kChoice:
@@ -153,7 +153,7 @@ std::string placeholder(const tasks::TrainOption& option) {
     case ValueKind::kColumns:
       return "COLUMNS";
     case ValueKind::kText:
-      return text_placeholder(option.name);
+      return text_metavar(option.name);
     default:  // the positional TASK, a flag
       return "";
   }
@@ -270,7 +270,7 @@ void add_train_command(CLI::App& app) {
   auto given = std::make_shared<std::vector<Given>>(table.size());
   for (std::size_t i = 0; i < table.size(); ++i) {
     CLI::Option* option = add_option(*cmd, table[i], (*given)[i]);
-    option->option_text(placeholder(table[i]));
+    option->option_text(metavar(table[i]));
     if (!table[i].group.empty()) option->group(std::string(table[i].group));
     if (!table[i].default_shown.empty()) option->default_str(std::string(table[i].default_shown));
   }
