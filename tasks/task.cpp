@@ -5,6 +5,7 @@
 #include <algorithm>
 
 #include "nn/hnn.h"
+#include "tasks/evaluate/rollouts.h"
 
 namespace hnn::tasks {
 
@@ -23,6 +24,18 @@ void Task::check_task_settings(const nlohmann::json& settings) const {
 std::unique_ptr<nn::DynamicsModel<double>> TaskRun::model_in_data_units() const {
   return nn::cast_model<double>(dynamics());
 }
+
+Eigen::VectorXd TaskRun::learned_h(const physics::Batch& x) const {
+  const std::unique_ptr<nn::DynamicsModel<double>> model = model_in_data_units();
+  const LearnedField learned = learned_field(*model);
+  HNN_TASKS_CHECK(learned.hamiltonian,
+                  "a {} model learns no scalar H (it predicts dx/dt directly): only an hnn, dhnn "
+                  "or lnn run has one",
+                  nn::to_string(model->config().model));
+  return learned.hamiltonian(x);
+}
+
+Eigen::VectorXd TaskRun::true_energy(const physics::Batch&) const { return {}; }
 
 std::vector<std::string> TaskRun::state_names() const {
   std::vector<std::string> names;

@@ -84,6 +84,13 @@ class TaskRun {
   /// The trained model as a user sees it, for `hnn export`: in the data's own units (a task
   /// that trains in other units folds them into the weights). By default dynamics() in double.
   virtual std::unique_ptr<nn::DynamicsModel<double>> model_in_data_units() const;
+  /// The learned H of states (rows, in the data's units: those of state_names()), for `hnn
+  /// hamiltonian`; by default model_in_data_units()'s. Throws Error for a model that learns no
+  /// scalar (a baseline).
+  virtual Eigen::VectorXd learned_h(const physics::Batch& x) const;
+  /// The true energy of the same states where the run knows its H (a field task's system, a
+  /// data run's --hamiltonian); empty otherwise (the default).
+  virtual Eigen::VectorXd true_energy(const physics::Batch& x) const;
 };
 
 class Task {

@@ -23,6 +23,7 @@ int main(int argc, char** argv) {
   hnn::app::add_analysis_commands(app);
   hnn::app::add_simulate_command(app);
   hnn::app::add_export_command(app);
+  hnn::app::add_hamiltonian_command(app);
   hnn::app::add_sweep_command(app);
   hnn::app::add_compare_command(app, argc, argv);
   try {

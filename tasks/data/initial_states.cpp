@@ -9,23 +9,6 @@
 
 namespace hnn::tasks {
 
-namespace {
-
-// "q, p (or x_0, x_1)": the names a header may use, for messages.
-std::string known_columns(const std::vector<std::string>& names) {
-  std::vector<std::string> numbered;
-  for (std::size_t c = 0; c < names.size(); ++c) numbered.push_back(fmt::format("x_{}", c));
-  if (numbered == names) return fmt::format("{}", fmt::join(names, ", "));
-  return fmt::format("{} (or {})", fmt::join(names, ", "), fmt::join(numbered, ", "));
-}
-
-// The state column that a header cell names, or -1.
-Eigen::Index state_column(const std::string& cell, const std::vector<std::string>& names) {
-  for (std::size_t c = 0; c < names.size(); ++c)
-    if (cell == names[c] || cell == fmt::format("x_{}", c)) return Eigen::Index(c);
-  return -1;
-}
-
 std::vector<std::string> split_values(const std::string& text) {
   std::vector<std::string> parts(1);
   for (char c : text) {
@@ -38,7 +21,18 @@ std::vector<std::string> split_values(const std::string& text) {
   return parts;
 }
 
-}  // namespace
+std::string known_columns(const std::vector<std::string>& names) {
+  std::vector<std::string> numbered;
+  for (std::size_t c = 0; c < names.size(); ++c) numbered.push_back(fmt::format("x_{}", c));
+  if (numbered == names) return fmt::format("{}", fmt::join(names, ", "));
+  return fmt::format("{} (or {})", fmt::join(names, ", "), fmt::join(numbered, ", "));
+}
+
+Eigen::Index state_column(const std::string& cell, const std::vector<std::string>& names) {
+  for (std::size_t c = 0; c < names.size(); ++c)
+    if (cell == names[c] || cell == fmt::format("x_{}", c)) return Eigen::Index(c);
+  return -1;
+}
 
 physics::Batch states_from_values(const std::vector<std::string>& values,
                                   const std::vector<std::string>& names) {

@@ -21,4 +21,13 @@ physics::Batch states_from_values(const std::vector<std::string>& values,
 /// the line and column of a bad cell or the header's unknown or missing column.
 physics::Batch states_from_file(const std::string& path, const std::vector<std::string>& names);
 
+/// The state column that `name` names, as `names[c]` or as x_c; -1 for none.
+Eigen::Index state_column(const std::string& name, const std::vector<std::string>& names);
+
+/// `text` split at its commas, without spaces or tabs: "1, 2" gives "1" and "2".
+std::vector<std::string> split_values(const std::string& text);
+
+/// "q, p (or x_0, x_1)": the names a state column may go by, for messages.
+std::string known_columns(const std::vector<std::string>& names);
+
 }  // namespace hnn::tasks

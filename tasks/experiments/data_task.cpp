@@ -206,6 +206,14 @@ class DataRun : public FieldModelRun {
 
   std::vector<std::string> state_names() const override { return p_.measured.state_names; }
 
+  // In the file's units, for any model with an H (a dhnn too, which model_in_data_units refuses).
+  Eigen::VectorXd learned_h(const Batch& x) const override {
+    const LearnedField file = in_file_units(learned_field(dynamics()), p_.units);
+    return file.hamiltonian ? file.hamiltonian(x) : TaskRun::learned_h(x);
+  }
+
+  Eigen::VectorXd true_energy(const Batch& x) const override { return energy(x); }
+
   // The units folded into the weights: the first layer takes x instead of z = (x - mean) / scale
   // and the last gives H in the file's units (an HNN) or dx/dt (a baseline). Exact: an affine map
   // into a linear layer is a linear layer.

@@ -111,6 +111,10 @@ class FieldRun : public FieldModelRun {
 
   double rollout_span() const override { return task_.rollout_config(s_.task_settings).t_end; }
 
+  Eigen::VectorXd true_energy(const Batch& x) const override {
+    return task_.has_truth() ? Eigen::VectorXd(task_.truth().energy_batch(x)) : Eigen::VectorXd();
+  }
+
  private:
   // The run's rollouts: the task's with its settings, as many as the data can start (checked
   // against an explicit "rollouts" in the constructor), the floor's draws from the run's seed.

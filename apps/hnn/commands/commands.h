@@ -16,6 +16,9 @@ void add_analysis_commands(CLI::App& app);
 void add_simulate_command(CLI::App& app);
 /// export: a trained HNN's H as C source or JSON (apps/hnn/commands/export.cpp).
 void add_export_command(CLI::App& app);
+/// hamiltonian: a run's learned H on a 2-D slice of state space
+/// (apps/hnn/commands/hamiltonian.cpp).
+void add_hamiltonian_command(CLI::App& app);
 /// sweep: a grid of runs from a spec file, through Dask (apps/hnn/sweep/command.cpp).
 void add_sweep_command(CLI::App& app);
 /// compare: the model families on a study's tasks beside the peers' published numbers, through
