@@ -228,8 +228,10 @@ def build_results(root):
         json.dump(table, f, indent=1)
 
 
-def run_plot(*args, script=PLOT):
-    return subprocess.run([PYTHON, script, *args], capture_output=True, text=True, timeout=300)
+def run_plot(*args, script=PLOT, env=None):
+    """Runs a chart script; env: variables added to this process's environment."""
+    return subprocess.run([PYTHON, script, *args], capture_output=True, text=True, timeout=300,
+                          env=None if env is None else {**os.environ, **env})
 
 
 def png_size(path):

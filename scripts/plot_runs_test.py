@@ -116,6 +116,93 @@ class RunChartsTest(unittest.TestCase):
         self.assertIn("nope.csv: no such file", run.stderr)
 
 
+# A stand-in for `hnn hamiltonian` (found through $HNN): it records its arguments and writes the
+# grid of a two-body state whose true energy is E = |x|^2 / 2 and whose learned H is E - 0.25,
+# so that the slice must be drawn + 0.25.
+FAKE_HNN = """#!/usr/bin/python3
+import sys
+args = sys.argv[1:]
+open(sys.argv[0] + ".args", "w").write(" ".join(args))
+opt = dict(zip(args[2::2], args[3::2]))
+axes = [(i.split("=")[0], *map(float, i.split("=")[1].split(":"))) for i in opt["--grid"].split(",")]
+held = [(i.split("=")[0], float(i.split("=")[1])) for i in opt["--at"].split(",")]
+n = int(opt["--points"])
+rows = [",".join([axes[0][0], axes[1][0], *(h[0] for h in held), "learned_h", "energy"])]
+for j in range(n):
+    for i in range(n):
+        a = axes[0][1] + (axes[0][2] - axes[0][1]) * i / (n - 1)
+        b = axes[1][1] + (axes[1][2] - axes[1][1]) * j / (n - 1)
+        e = 0.5 * (a * a + b * b + sum(v * v for _, v in held))
+        rows.append(",".join(map(repr, [a, b, *(v for _, v in held), e - 0.25, e])))
+open(opt["--out"], "w").write("\\n".join(rows) + "\\n")
+"""
+
+
+class SliceChartTest(unittest.TestCase):
+    """More than one degree of freedom: plot.py --runs draws the learned H on a 2-D slice from
+    `hnn hamiltonian`'s grid, or from a grid CSV given with --h-grid."""
+
+    @classmethod
+    def setUpClass(cls):
+        cls.root = tempfile.mkdtemp(prefix="plot_slice_test_")
+        build_results(os.path.join(cls.root, "results"))
+        cls.runs = [os.path.join(cls.root, "results", "two-body", m) for m in ("baseline", "hnn")]
+        cls.hnn = os.path.join(cls.root, "hnn")
+        with open(cls.hnn, "w") as f:
+            f.write(FAKE_HNN)
+        os.chmod(cls.hnn, 0o755)
+
+    @classmethod
+    def tearDownClass(cls):
+        shutil.rmtree(cls.root, ignore_errors=True)
+
+    def assert_slice(self, out, run):
+        self.assertEqual(run.returncode, 0, run.stderr)
+        self.assertNotIn("Traceback", run.stderr)
+        self.assertIn(os.path.join(out, "h_slice_two-body.png"), run.stdout.split())
+        width, height = png_size(os.path.join(out, "h_slice_two-body.png"))
+        self.assertGreater(width, 500)
+        svg = svg_text(os.path.join(out, "h_slice_two-body.svg"))
+        for words in ("True energy E", "Learned H + 0.25 (the best constant on this grid)",
+                      "H is defined only up to a constant"):
+            self.assertIn(words, svg)
+        self.assertIn("the learned H is drawn + 0.25,", run.stderr)
+
+    def test_runs_of_more_degrees_of_freedom_draw_the_slice_of_hnn_hamiltonian(self):
+        out = os.path.join(self.root, "out")
+        run = run_plot("--runs", *self.runs, "--out", out, env={"HNN": self.hnn})
+        self.assert_slice(out, run)
+        with open(self.hnn + ".args") as f:
+            args = f.read().split()
+        # The first coordinate and its momentum; the other six held at the shown start.
+        self.assertEqual(args[:2], ["hamiltonian", self.runs[1]])
+        grid = args[args.index("--grid") + 1]
+        self.assertRegex(grid, r"^x_0=[-0-9.e]+:[-0-9.e]+,x_4=[-0-9.e]+:[-0-9.e]+$")
+        self.assertEqual(len(args[args.index("--at") + 1].split(",")), 6)
+        self.assertIn(os.path.join(out, "h_grid_two-body.csv"), run.stdout.split())
+
+    def test_a_grid_csv_is_drawn_without_the_hnn_program(self):
+        out = os.path.join(self.root, "given")
+        made = os.path.join(self.root, "made")
+        os.makedirs(made)
+        grid = os.path.join(made, "grid.csv")
+        subprocess.run([self.hnn, "hamiltonian", "RUN", "--grid", "x=-1:1,px=-2:2", "--at",
+                        "y=0.5", "--points", "7", "--out", grid], check=True)
+        run = run_plot("--runs", *self.runs, "--out", out, "--h-grid", grid,
+                       env={"HNN": os.path.join(self.root, "missing")})
+        self.assert_slice(out, run)
+        self.assertIn("y = 0.5", svg_text(os.path.join(out, "h_slice_two-body.svg")))
+
+    def test_a_grid_that_is_not_one_is_an_error(self):
+        bad = os.path.join(self.root, "bad.csv")
+        with open(bad, "w") as f:
+            f.write("x,px,learned_h,energy\n0,0,1,1\n1,0,1,1\n0,1,1,1\n")
+        run = run_plot("--runs", *self.runs, "--out", os.path.join(self.root, "bad"),
+                       "--h-grid", bad)
+        self.assertEqual(run.returncode, 1)
+        self.assertIn("3 rows are not a grid of 2 x 2 points of x and px", run.stderr)
+
+
 class ScriptHelpTest(unittest.TestCase):
     def test_every_script_answers_help_without_running_anything(self):
         """Each script with --help prints its header and exits 0, with only dirname and sed on

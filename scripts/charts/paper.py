@@ -112,6 +112,12 @@ per model and all of one task and the same held-out data, into DIR:
                     the phase plane, interpolated between the test rollouts; the learned H is
                     shifted to equal the true energy where the shown rollout starts (H is
                     defined only up to a constant)
+  h_slice_<task>    more degrees of freedom and an HNN run: the true energy and the learned H
+                    on a 2-D slice (the first coordinate and its momentum, the others held at
+                    the shown rollout's start), from `hnn hamiltonian` (found as $HNN,
+                    build/apps/hnn or on the PATH; its grid is kept as h_grid_<task>.csv) or
+                    from --h-grid CSV; the learned H is shifted by the constant that fits it
+                    best to the true energy, printed on the panel
   rollout_<integrator>_<task>  Figure 2 of the runs' `hnn rollout` files
 A run that lacks metrics.json or rollout.csv, or runs of different tasks or data, are an error
 naming them.
@@ -124,6 +130,8 @@ from the metrics.json beside the file when there is one.""")
     p.add_argument("--runs", nargs="+", metavar="RUN", help="`hnn train` run folders")
     p.add_argument("--rollouts", nargs="+", metavar="CSV", help="rollout CSV files of hnn")
     p.add_argument("--out", metavar="DIR", help="where --runs and --rollouts write")
+    p.add_argument("--h-grid", metavar="CSV",
+                   help="with --runs: the learned H's slice from this `hnn hamiltonian` CSV")
     return p
 
 
@@ -135,9 +143,11 @@ def main(argv):
         if args.results is not None or args.out is None or None not in (args.runs,
                                                                         args.rollouts):
             p.error("--runs or --rollouts takes --out DIR, and no RESULTS_DIR")
+        if args.h_grid is not None and args.runs is None:
+            p.error("--h-grid goes with --runs")
         try:
             if args.runs is not None:
-                plot_runs(args.runs, args.out)
+                plot_runs(args.runs, args.out, args.h_grid)
             else:
                 plot_rollout_files(args.rollouts, args.out)
         except (PlotError, OSError) as e:

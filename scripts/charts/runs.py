@@ -7,7 +7,7 @@ import os
 
 import numpy as np
 
-from . import fig2, h_contour, training_curves
+from . import fig2, h_contour, h_slice, training_curves
 from .common import MODELS, PIXEL_TASK, TITLES, PlotError, note, read_csv, read_json
 from .rollout import Rollout, rollouts_of, setting
 
@@ -108,6 +108,19 @@ def draw_contour(out, task, runs, title, roll, stem=None):
     return h_contour.draw_h_contour(out, task, roll, names, title, stem=stem)
 
 
+def draw_slice(out, task, run, title, h_grid=None):
+    """The learned H beside the true energy on a 2-D slice (h_slice_<task>) of an HNN run of
+    more than one degree of freedom: from the grid CSV h_grid, or from `hnn hamiltonian` run on
+    it through its shown test rollout's first state (out/h_grid_<task>.csv)."""
+    written = []
+    if h_grid is None:
+        h_grid = h_slice.make_grid(run["folder"], run["rollout"], out, f"h_grid_{task}")
+        if h_grid is None:
+            return []
+        written.append(h_grid)
+    return written + h_slice.draw_h_slice(out, task, h_slice.read_grid(h_grid), title)
+
+
 def draw_paths(out, task, runs, title):
     """Figure 2 of the runs' `hnn rollout` files, one per file name: both models in one figure
     when their files hold the same trajectories, else one figure each."""
@@ -128,10 +141,11 @@ def draw_paths(out, task, runs, title):
     return written
 
 
-def plot_runs(folders, out):
+def plot_runs(folders, out, h_grid=None):
     """Figure 2 of the given run folders into out/fig2_<task>, their loss curves
-    (training_curves), the HNN's learned H against the true one (h_contour_<task>, one degree
-    of freedom) and Figure 2 of their rollout_<integrator>.csv; returns the files written."""
+    (training_curves), the HNN's learned H against the true one (h_contour_<task> for one
+    degree of freedom, else h_slice_<task> from the grid CSV h_grid or `hnn hamiltonian`) and
+    Figure 2 of their rollout_<integrator>.csv; returns the files written."""
     loaded = [load_run(folder) for folder in folders]
     runs = check_runs(loaded)
     task = loaded[0]["task"]
@@ -143,8 +157,12 @@ def plot_runs(folders, out):
     title = run_title(task, runs)
     written = fig2.draw_fig2(out, task, runs, rolls, truth, title=title)
     written += training_curves.draw_training_curves(out, {task: runs}, title=title)
-    if "hnn" in runs:
+    if h_grid is not None and "hnn" not in runs:
+        raise PlotError(f"--h-grid {h_grid}: the learned H of which run? give an hnn run")
+    if "hnn" in runs and runs["hnn"]["rollout"].d == 2 and h_grid is None:
         written += draw_contour(out, task, runs, title, runs["hnn"]["rollout"])
+    elif "hnn" in runs:
+        written += draw_slice(out, task, runs["hnn"], title, h_grid)
     return written + draw_paths(out, task, runs, title)
 
 
