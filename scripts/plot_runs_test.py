@@ -105,6 +105,25 @@ class RunChartsTest(unittest.TestCase):
                       run.stderr)
         self.assert_drawn(out, ["short_hnn", "h_contour_short_hnn"], run.stdout)
 
+    def test_a_loss_curve_in_standardised_units_says_so_on_its_chart(self):
+        """A data run's loss_curve.csv names its columns train_loss_standardised and
+        test_loss_standardised: read as the loss, and labelled in those units."""
+        copy = os.path.join(self.root, "standardised", "hnn")
+        shutil.copytree(self.hnn, copy)
+        path = os.path.join(copy, "loss_curve.csv")
+        with open(path) as f:
+            text = f.read()
+        with open(path, "w") as f:
+            f.write(text.replace("step,train_loss,test_loss",
+                                 "step,train_loss_standardised,test_loss_standardised", 1))
+        out = os.path.join(self.root, "standardised_out")
+        run = self.plot("--runs", copy, "--out", out)
+        self.assertEqual(run.returncode, 0, run.stderr)
+        self.assertIn("(standardised units)", svg_text(os.path.join(out, "training_curves.svg")))
+        run = self.plot("--runs", self.hnn, "--out", os.path.join(self.root, "plain_out"))
+        self.assertNotIn("standardised", svg_text(os.path.join(self.root, "plain_out",
+                                                               "training_curves.svg")))
+
     def test_runs_and_rollouts_need_out_and_not_both(self):
         for args in (["--runs", self.hnn], ["--rollouts", "x.csv", "--runs", self.hnn,
                                             "--out", self.root]):

@@ -231,8 +231,11 @@ json run_training(const RunOptions& o) {
   folder.create();
   const TrainResult trained = run->train(loop_options(o, settings, folder));
   run->save(folder.params_file());
-  folder.write_loss_curve(trained.curve);
   json metrics = run_metrics(*run, folder, trained, settings);
+  // A run that learns in standardised units (a data run) watched its loss in them: the columns
+  // say so, as metrics.json's keys do.
+  folder.write_loss_curve(trained.curve,
+                          metrics.contains("test_loss_standardised") ? "_standardised" : "");
   metrics["data_seconds"] = data_seconds;
   folder.write_metrics(metrics);
   return metrics;

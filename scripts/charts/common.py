@@ -132,6 +132,18 @@ def read_csv(path, required, text=()):
             for i, h in enumerate(header)}
 
 
+def read_loss_curve(path):
+    """loss_curve.csv as {'step', 'train_loss', 'test_loss', 'units'}: a data run's columns
+    are train_loss_standardised and test_loss_standardised (units "standardised"); files
+    written before they said so have the plain names (units None)."""
+    with open(path, newline="", encoding="utf-8", errors="replace") as f:
+        header = f.readline()
+    suffix = "_standardised" if "train_loss_standardised" in header else ""
+    cols = read_csv(path, ["step", f"train_loss{suffix}", f"test_loss{suffix}"])
+    return {"step": cols["step"], "train_loss": cols[f"train_loss{suffix}"],
+            "test_loss": cols[f"test_loss{suffix}"], "units": suffix[1:] or None}
+
+
 def read_rows(path):
     """A CSV with a header as a list of {column: text} (the benchmarks' and hnn sweep's)."""
     with open(path, newline="") as f:

@@ -6,7 +6,8 @@ import argparse
 import os
 
 from . import fig2, fig3, table1, training_curves
-from .common import MODELS, PIXEL_TASK, TASKS, PlotError, error, note, read_csv, read_json
+from .common import (MODELS, PIXEL_TASK, TASKS, PlotError, error, note, read_json,
+                     read_loss_curve)
 from .rollout import Rollout, rollouts_of
 from .runs import plot_rollout_files, plot_runs
 
@@ -19,8 +20,7 @@ def load_model(task_dir, task, model):
         return None
     run = {}
     readers = {"metrics": ("metrics.json", read_json),
-               "loss": ("loss_curve.csv",
-                        lambda p: read_csv(p, ["step", "train_loss", "test_loss"])),
+               "loss": ("loss_curve.csv", read_loss_curve),
                "rollout": ("rollout.csv", Rollout)}
     for key, (name, reader) in readers.items():
         path = os.path.join(model_dir, name)

@@ -8,7 +8,7 @@ import os
 import numpy as np
 
 from . import fig2, h_contour, h_slice, training_curves
-from .common import MODELS, PIXEL_TASK, TITLES, PlotError, note, read_csv, read_json
+from .common import MODELS, PIXEL_TASK, TITLES, PlotError, note, read_json, read_loss_curve
 from .rollout import Rollout, rollouts_of, setting
 
 
@@ -41,8 +41,7 @@ def load_run(folder):
         raise PlotError(f"{os.path.join(folder, 'metrics.json')}: model '{run['model']}' is not"
                         f" one of {', '.join(MODELS)}")
     loss = os.path.join(folder, "loss_curve.csv")
-    run["loss"] = (read_csv(loss, ["step", "train_loss", "test_loss"])
-                   if os.path.isfile(loss) else None)
+    run["loss"] = read_loss_curve(loss) if os.path.isfile(loss) else None
     if run["loss"] is None:
         note(f"{loss}: missing, no loss curve for this run")
     run["paths"] = {os.path.basename(p)[:-4]: Rollout(p)

@@ -34,9 +34,14 @@ def draw_training_curves(results, all_runs, title=None):
                         label=f"{LABELS[model]}, {split}")
                 curves.append(y)
         log_y_if_positive(ax, *curves)
-        # A data run's loss_curve.csv is in standardised units (metrics.json's "units").
-        ylabel = {"pixel-pendulum": "loss: ae + cc + 0.1 hnn",
-                  "data": "loss: MSE of dx/dt (standardised units)"}.get(task, "loss: MSE of dx/dt")
+        # A data run's loss_curve.csv is in standardised units: its columns say so (older
+        # files only through metrics.json's "units", so the data task's label says it too).
+        standardised = task == "data" or any(
+            ((all_runs[task].get(m) or {}).get("loss") or {}).get("units") == "standardised"
+            for m in MODELS)
+        ylabel = ("loss: ae + cc + 0.1 hnn" if task == "pixel-pendulum" else
+                  "loss: MSE of dx/dt (standardised units)" if standardised else
+                  "loss: MSE of dx/dt")
         ax.set(title=title or TITLES.get(task, task), xlabel="training step", ylabel=ylabel)
         ax.legend()
     for ax in list(axes.flat)[len(tasks):]:

@@ -24,8 +24,9 @@ void RunFolder::write_metrics(const nlohmann::json& metrics) const {
   write_text("metrics.json", metrics.dump(2) + "\n");
 }
 
-void RunFolder::write_loss_curve(const std::vector<CurvePoint>& curve) const {
-  std::string csv = "step,train_loss,test_loss\n";
+void RunFolder::write_loss_curve(const std::vector<CurvePoint>& curve,
+                                 std::string_view units) const {
+  std::string csv = fmt::format("step,train_loss{},test_loss{}\n", units, units);
   for (const CurvePoint& p : curve)
     csv += fmt::format("{},{:.9g},{:.9g}\n", p.step, p.train_loss, p.test_loss);
   write_text("loss_curve.csv", csv);

@@ -31,8 +31,9 @@ class RunFolder {
   /// Writes RUN/name atomically.
   void write_text(std::string_view name, std::string_view content) const;
   void write_metrics(const nlohmann::json& metrics) const;
-  /// loss_curve.csv: step,train_loss,test_loss.
-  void write_loss_curve(const std::vector<CurvePoint>& curve) const;
+  /// loss_curve.csv: step,train_loss<units>,test_loss<units>; `units` names losses in other
+  /// units than the file's ("_standardised": a data run's, as metrics.json's keys say).
+  void write_loss_curve(const std::vector<CurvePoint>& curve, std::string_view units = {}) const;
   /// metrics.json; throws Error saying the folder is not a finished run when it is missing.
   nlohmann::json read_metrics() const;
 

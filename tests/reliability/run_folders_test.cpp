@@ -8,6 +8,7 @@
 
 #include "reliability_util.h"
 #include "tasks/data/file_digest.h"
+#include "tasks/error.h"
 
 namespace hnn::reliability {
 namespace {

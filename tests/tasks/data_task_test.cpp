@@ -121,6 +121,7 @@ TEST(DataTask, TrainsOnACsvAndEvaluatesOnHeldOutTrajectories) {
   // The loss watched during training (loss_curve.csv, the progress line) is in metrics.json
   // under its own name, and "units" says which keys are in which units.
   const std::vector<std::string> curve = read_lines(dir / "hnn" / "loss_curve.csv");
+  EXPECT_EQ(curve[0], "step,train_loss_standardised,test_loss_standardised");  // the file says so
   const double watched = std::stod(curve.back().substr(curve.back().rfind(',') + 1));
   EXPECT_NEAR(m["test_loss_standardised"].get<double>(), watched, 1e-6 * watched);
   EXPECT_NE(m["test_loss_standardised"], m["test_loss"]);
