@@ -15,6 +15,8 @@ import subprocess
 import tempfile
 import unittest
 
+import numpy as np
+
 from plot_fixtures import (SCRIPTS, build_results, png_size, run_plot, spring_rollouts,
                            write_paths, write_rollout)
 
@@ -22,6 +24,19 @@ from plot_fixtures import (SCRIPTS, build_results, png_size, run_plot, spring_ro
 def svg_text(path):
     with open(path) as f:
         return f.read()
+
+
+def file_valid_time(model, threshold=0.1):
+    """The valid prediction time of spring_rollouts(model), computed here: the mean time until
+    |x^ - x| / (|x^| + |x|) first passes the threshold."""
+    t, trajs = spring_rollouts(model)
+    times = []
+    for true, pred, _, _, _ in trajs:
+        error = np.linalg.norm(pred - true, axis=1) / (np.linalg.norm(pred, axis=1)
+                                                       + np.linalg.norm(true, axis=1))
+        past = np.nonzero(~(error[1:] <= threshold))[0]
+        times.append(t[past[0] + 1] if len(past) else t[-1])
+    return float(np.mean(times)) - t[0]
 
 
 class RunChartsTest(unittest.TestCase):
@@ -64,8 +79,14 @@ class RunChartsTest(unittest.TestCase):
         fig2 = svg_text(os.path.join(out, "fig2_spring.svg"))
         self.assertIn("H is defined only up to a constant: drawn + 0.092", fig2)
         self.assertIn("Baseline NN, test", svg_text(os.path.join(out, "training_curves.svg")))
-        self.assertIn("hnn rollout: rollout_dopri5.csv",
-                      svg_text(os.path.join(out, "rollout_dopri5_spring.svg")))
+        paths = svg_text(os.path.join(out, "rollout_dopri5_spring.svg"))
+        self.assertIn("hnn rollout: rollout_dopri5.csv", paths)
+        # The legend quotes the file's own rollouts, not the run's test rollouts (4.25).
+        self.assertNotIn("valid pred. time 4.25", paths)
+        self.assertIn(f"valid pred. time {file_valid_time('hnn'):.3g} (these 3 rollouts)", paths)
+        t, trajs = spring_rollouts("hnn")
+        mse = np.mean([np.mean((e - f) ** 2) for _, _, e, f, _ in trajs])
+        self.assertIn(f"HNN {mse:.2e})", paths)  # not the run's 3.84e-04
 
     def test_rollout_files_are_drawn_in_either_layout(self):
         out = os.path.join(self.root, "files")

@@ -101,10 +101,19 @@ def phase_axes(d, metrics):
 
 def run_labels(runs):
     """{model: legend text}: the model's name, with metrics.json's valid_prediction_time and
-    coordinate_mse (data runs) when it has them."""
+    coordinate_mse (data runs) when it has them; for a run marked "of_file" (an `hnn rollout`
+    file), the valid prediction time of the file's own rollouts instead."""
     labels = {}
     for model in MODELS:
-        metrics = (runs.get(model) or {}).get("metrics") or {}
+        run = runs.get(model) or {}
+        metrics = run.get("metrics") or {}
+        if run.get("of_file"):
+            threshold = metrics.get("valid_prediction_threshold")
+            roll = run["rollout"]
+            time = roll.valid_prediction_time(threshold if is_number(threshold) else 0.1)
+            labels[model] = (f"{LABELS[model]}\nvalid pred. time {time:.3g}"
+                             f" (these {len(roll.trajs)} rollouts)")
+            continue
         parts = [f"{text} {metrics[key]:{form}}" for key, text, form in
                  (("valid_prediction_time", "valid pred. time", ".3g"),
                   ("coordinate_mse", "coord. MSE", ".2e"))

@@ -86,6 +86,31 @@ class Rollout:
                  np.mean((tr["pred"][:, columns] - tr["true"][:, columns]) ** 2, axis=1))
                 for tr in self.trajs]
 
+    def valid_prediction_time(self, threshold=0.1):
+        """The mean over trajectories of the time until the relative state error |x^ - x| /
+        (|x^| + |x|) first passes `threshold` (the whole span when it never does), as hnn's
+        valid_prediction_time (tasks/evaluate/state_errors.cpp); rows without a truth are
+        skipped."""
+        times = []
+        for tr in self.trajs:
+            gap = np.linalg.norm(tr["pred"] - tr["true"], axis=1)
+            error = gap / (np.linalg.norm(tr["pred"], axis=1) + np.linalg.norm(tr["true"], axis=1))
+            past = [k for k in range(1, len(tr["t"])) if np.all(np.isfinite(tr["true"][k]))
+                    and not error[k] <= threshold]
+            times.append(tr["t"][past[0] if past else -1] - tr["t"][0])
+        return float(np.mean(times))
+
+    def energy_mse(self):
+        """The mean over trajectories of the mean over time of (E(x) - E(x^))^2, the true
+        energy along the truth against along the model's path, as hnn's energy_mse; None
+        without both."""
+        per = []
+        for tr in self.trajs:
+            gap = (tr["true_energy"] - tr["pred_energy"]) ** 2
+            if np.any(np.isfinite(gap)):
+                per.append(np.nanmean(gap))
+        return float(np.mean(per)) if per else None
+
     def uneven(self):
         """Whether the trajectories differ in start time or length (held-out measured data)."""
         return len({(tr["t"][0], len(tr["t"])) for tr in self.trajs}) > 1
@@ -159,12 +184,15 @@ def setting(metrics, key):
 
 
 def energy_summary(runs):
-    """' (energy MSE: baseline 1.7e-01, HNN 3.8e-04)' from metrics.json, or ''."""
+    """' (energy MSE: baseline 1.7e-01, HNN 3.8e-04)' from metrics.json (for a run marked
+    "of_file", an `hnn rollout` file: of its own rollouts), or ''."""
     parts = []
     for model in MODELS:
-        metrics = (runs.get(model) or {}).get("metrics") or {}
-        if is_number(metrics.get("energy_mse")):
-            parts.append(f"{'HNN' if model == 'hnn' else model} {metrics['energy_mse']:.2e}")
+        run = runs.get(model) or {}
+        value = (run["rollout"].energy_mse() if run.get("of_file")
+                 else (run.get("metrics") or {}).get("energy_mse"))
+        if is_number(value):
+            parts.append(f"{'HNN' if model == 'hnn' else model} {value:.2e}")
     return f" (energy MSE: {', '.join(parts)})" if parts else ""
 
 

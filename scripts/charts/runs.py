@@ -130,8 +130,8 @@ def draw_paths(out, task, runs, title):
         together = all(same_trajectories(rolls[0], r) for r in rolls[1:])
         groups = [having] if together else [{m: run} for m, run in having.items()]
         for group in groups:
-            view = {m: {"metrics": run["metrics"], "rollout": run["paths"][name]}
-                    for m, run in group.items()}
+            view = {m: {"metrics": run["metrics"], "rollout": run["paths"][name],
+                        "of_file": True} for m, run in group.items()}
             show_longest([v["rollout"] for v in view.values()])
             stem = f"{name}_{task}" + ("" if together else f"_{next(iter(group))}")
             shown_rolls, truth = rollouts_of(view)
@@ -179,7 +179,8 @@ def load_rollout_file(path):
     if model not in MODELS:
         raise PlotError(f"{beside}: model '{model}' is not one of {', '.join(MODELS)}")
     return {"path": path, "task": setting(metrics, "task") or "rollout", "model": model,
-            "metrics": metrics, "rollout": roll}
+            "metrics": metrics, "rollout": roll,
+            "of_file": os.path.basename(path) != "rollout.csv"}  # a run's own: its metrics
 
 
 def plot_rollout_files(paths, out):
