@@ -220,6 +220,7 @@ class SliceChartTest(unittest.TestCase):
         self.assertRegex(grid, r"^x_0=[-0-9.e]+:[-0-9.e]+,x_4=[-0-9.e]+:[-0-9.e]+$")
         self.assertEqual(len(args[args.index("--at") + 1].split(",")), 6)
         self.assertIn(os.path.join(out, "h_grid_two-body.csv"), run.stdout.split())
+        self.assertIn("q1 (x_0)", svg_text(os.path.join(out, "h_slice_two-body.svg")))
 
     def test_a_grid_csv_is_drawn_without_the_hnn_program(self):
         out = os.path.join(self.root, "given")

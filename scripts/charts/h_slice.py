@@ -1,6 +1,7 @@
 """The learned H beside the true energy on a 2-D slice of a state of more than one degree of
-freedom (h_slice_<task>), from the grid CSV of `hnn hamiltonian` (tasks/hamiltonian_grid.h:
-the two axes' columns first, then the held ones, learned_h, energy). plot.py --runs makes the
+freedom (h_slice_<task>), from the grid CSV of `hnn hamiltonian`
+(apps/hnn/commands/hamiltonian.cpp: the two axes' columns first, then the held ones,
+learned_h, energy). plot.py --runs makes the
 grid by running `hnn hamiltonian` on the HNN run, through the shown test rollout's first state,
 or reads one given with --h-grid. The learned H is drawn shifted by the constant that fits it
 best to the true energy on the grid (least squares: the mean difference), as H is defined only
@@ -90,12 +91,16 @@ def best_shift(g):
 
 
 def held_text(g):
-    return ", ".join(f"{n} = {v:.3g}" for n, v in g["held"]) or "nothing else"
+    """"y = 0, py = 0.5": the held columns, wrapped to lines of six (a three-body state has
+    ten)."""
+    items = [f"{n} = {v:.3g}" for n, v in g["held"]]
+    return ",\n".join(", ".join(items[i:i + 6]) for i in range(0, len(items), 6)) or "nothing"
 
 
-def draw_h_slice(out, task, g, title, stem=None):
+def draw_h_slice(out, task, g, title, stem=None, labels=None):
     """Two panels on one colour scale, the true energy and the learned H + c, over the grid's
-    slice; one (the learned H as learned) without a true energy. Prints the shift."""
+    slice; one (the learned H as learned) without a true energy. Prints the shift. labels:
+    the axes' meanings ("q1", "p1") when the grid's columns are only numbered (x_0, x_4)."""
     shift = best_shift(g)
     truth = shift is not None
     source = g["energy"] if truth else g["learned"]
@@ -119,8 +124,11 @@ def draw_h_slice(out, task, g, title, stem=None):
     for ax, (values, text) in zip(axes, panels):
         filled = ax.contourf(g["x"], g["y"], values, levels=levels, cmap="viridis",
                              extend="both")
-        ax.contour(g["x"], g["y"], values, levels=levels[::3], colors="white", linewidths=0.5)
-        ax.set(xlabel=g["names"][0], ylabel=g["names"][1], title=text)
+        ax.contour(g["x"], g["y"], values, levels=levels[::3], colors="white", linewidths=0.5,
+                   negative_linestyles="solid")
+        axis = [n if not labels or labels[k] == n else f"{labels[k]} ({n})"
+                for k, n in enumerate(g["names"])]
+        ax.set(xlabel=axis[0], ylabel=axis[1], title=text)
     fig.colorbar(filled, ax=list(axes), label="H")
     fig.suptitle(f"{title}: true and learned H on the slice {held_text(g)}"
                  if truth else f"{title}: learned H on the slice {held_text(g)}")

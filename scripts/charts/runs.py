@@ -117,7 +117,12 @@ def draw_slice(out, task, run, title, h_grid=None):
         if h_grid is None:
             return []
         written.append(h_grid)
-    return written + h_slice.draw_h_slice(out, task, h_slice.read_grid(h_grid), title)
+    grid = h_slice.read_grid(h_grid)
+    roll = run["rollout"]
+    _, labels, _ = fig2.phase_axes(roll.d, run["metrics"])
+    if grid["names"] != [roll.names[0], roll.names[roll.d // 2]]:
+        labels = None  # a grid of other columns (--h-grid): their names alone
+    return written + h_slice.draw_h_slice(out, task, grid, title, labels=labels)
 
 
 def draw_paths(out, task, runs, title):

@@ -1,6 +1,6 @@
 // `hnn hamiltonian`: a run's learned H and the true energy on a 2-D slice of its state space, as
-// CSV (tasks/hamiltonian_grid.h). Its values are those `hnn rollout` reports at the same states
-// (the learned H of the model's path at t = 0, the true energy of the truth's), in the data
+// CSV (apps/hnn/commands/hamiltonian.cpp). Its values are those `hnn rollout` reports at the same
+// states (the learned H of the model's path at t = 0, the true energy of the truth's), in the data
 // file's units for a data run; a baseline and bad slices are refused in one line, with no file
 // (docs/inputs.md).
 
