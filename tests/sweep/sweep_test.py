@@ -106,6 +106,9 @@ class SpecErrors(SweepCase):
          "key 'task': given both beside \"grids\" and in grid 1"),
         ('{"task": ["spring"], "charts": [{"x": "seed", "y": "test_loss"}]}', "json",
          "key 'charts': chart 1: 'x' must be one of the spec's keys"),
+        ('{"task": ["spring"], "charts": [{"x": "seed", "x_metric": "train_seconds", '
+         '"y": "test_loss"}]}', "json",
+         "key 'charts': chart 1: expected an object with \"y\" and one of \"x\""),
         ('{"task": ["spring"],', "json", "not valid JSON"),
         ("task: [spring]\nseed: [0, x]\n", "yaml", "key 'seed': expected an integer"),
         ("task: [spring]\n  seed: [0\n", "yaml", "not valid YAML"),
@@ -207,6 +210,7 @@ grids:
   - {{task: [real-pendulum], data: ["{bad_data}"], steps: [50]}}
 charts:
   - {{x: seed, y: test_loss}}
+  - {{x_metric: train_seconds, y: test_loss, log_x: true}}
 """)
         out = self.path("out")
         result = hnn("sweep", spec, "--out", out, "--workers", "2")
@@ -223,6 +227,7 @@ charts:
         self.assertEqual("hnn: error: " + failed["reason"], direct.stderr.strip())
         self.assertIn(f"failed: {failed['run']}: {failed['reason']}", result.stdout)
         self.assertTrue(os.path.exists(os.path.join(out, "chart-1.png")))
+        self.assertTrue(os.path.exists(os.path.join(out, "chart-2.png")))
         self.assertTrue(
             read_text(os.path.join(out, "results.csv")).startswith("run,status,reason,"))
 
@@ -367,6 +372,28 @@ class Cluster(SweepCase):
         self.assertIn("all 12 runs are finished (0 failed): nothing to run", again.stdout)
         self.assertEqual(events(out), log)
         self.assertLess(time.time() - start, 30)
+
+
+class Charts(unittest.TestCase):
+    """The x_metric chart's points: seeds pooled per setting, labelled by what varies."""
+
+    def test_metric_points_pool_seeds_and_label_the_varying_keys(self):
+        sys.path.insert(0, os.path.join(SOURCE, "apps", "hnn", "sweep"))
+        import sweep_report
+
+        def run(hidden, seed, secs, err):
+            return {"values": {"task": "spring", "fit": "sampled", "hidden": hidden,
+                               "seed": seed},
+                    "metrics": {"train_seconds": secs, "test_loss": err}}
+        rows = [run(100, 0, 1.0, 4.0), run(100, 1, 3.0, 2.0), run(10, 0, 0.5, 9.0),
+                {"values": {"hidden": 5, "seed": 0}, "metrics": {"test_loss": 1.0}}]
+        points = sweep_report.metric_points(rows, "train_seconds", "test_loss", "fit", None)
+        self.assertEqual([p[4] for p in points], ["10", "100"])  # ordered by time
+        mx, my, ex, ey, _ = points[1]
+        self.assertEqual((mx, my), (2.0, 3.0))
+        self.assertAlmostEqual(ex, 1.0)
+        self.assertAlmostEqual(ey, 1.0)
+        self.assertEqual(points[0][2:4], (0.0, 0.0))  # one seed: no error bar
 
 
 class Expansion(SweepCase):

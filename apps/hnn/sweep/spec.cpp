@@ -187,14 +187,16 @@ json checked_charts(const ordered_json& spec, const std::set<std::string>& keys)
   json out = json::array();
   for (std::size_t i = 0; i < charts.size(); ++i) {
     const ordered_json& c = charts[i];
-    if (!c.is_object() || !c.contains("x") || !c.contains("y"))
-      throw fail(i, fmt::format("expected an object with \"x\" and \"y\", got {}", c.dump()));
+    if (!c.is_object() || c.contains("x") == c.contains("x_metric") || !c.contains("y"))
+      throw fail(i, fmt::format("expected an object with \"y\" and one of \"x\" (a spec key) "
+                                "or \"x_metric\" (a metric), got {}",
+                                c.dump()));
     for (const auto& [k, v] : c.items()) {
       if (k == "x" || k == "series" || k == "facet") {
         if (!v.is_string() || !keys.count(v.get<std::string>()))
           throw fail(i, fmt::format("'{}' must be one of the spec's keys ({}), got {}", k,
                                     fmt::join(keys, ", "), v.dump()));
-      } else if (k == "y" || k == "title" || k == "file") {
+      } else if (k == "y" || k == "x_metric" || k == "title" || k == "file") {
         if (!v.is_string() || v.get<std::string>().empty())
           throw fail(i, fmt::format("'{}' must be a non-empty string, got {}", k, v.dump()));
         if (k == "file" && v.get<std::string>().find('/') != std::string::npos)
@@ -214,9 +216,9 @@ json checked_charts(const ordered_json& spec, const std::set<std::string>& keys)
         if (!v.is_boolean())
           throw fail(i, fmt::format("'{}' must be true or false, got {}", k, v.dump()));
       } else {
-        throw fail(
-            i, fmt::format(
-                   "unknown key '{}' (x, y, series, facet, where, log_x, log_y, title, file)", k));
+        throw fail(i, fmt::format("unknown key '{}' (x, x_metric, y, series, facet, where, log_x, "
+                                  "log_y, title, file)",
+                                  k));
       }
     }
     out.push_back(json::parse(c.dump()));

@@ -108,11 +108,45 @@ def mean_and_error(ys):
     return m, math.sqrt(var / len(ys))
 
 
+def metric_points(points, x_metric, y, series, facet):
+    """A chart of one metric against another (x_metric: train_seconds against an error, say):
+    one point per setting, its runs (the seeds) pooled, with the standard error of both means,
+    ordered by x and labelled by the keys that vary among the points."""
+    groups = {}
+    for r in points:
+        if not isinstance(r["metrics"].get(x_metric), (int, float)):
+            continue
+        key = tuple(sorted((k, cell(v)) for k, v in r["values"].items()
+                           if k not in ("seed", series, facet)))
+        groups.setdefault(key, []).append(r)
+    varying = {k for key in groups for k, v in key
+               if len({dict(other).get(k) for other in groups}) > 1}
+    out = []
+    for key, runs in groups.items():
+        mx, ex = mean_and_error([r["metrics"][x_metric] for r in runs])
+        my, ey = mean_and_error([r["metrics"][y] for r in runs])
+        label = ",".join(f"{v}" for k, v in key if k in varying)
+        out.append((mx, my, ex, ey, label))
+    return sorted(out)
+
+
+def draw_metric_series(ax, points, chart, series_value):
+    got = metric_points(points, chart["x_metric"], chart["y"], chart.get("series"),
+                        chart.get("facet"))
+    if not got:
+        return
+    xs, ys, exs, eys, labels = zip(*got)
+    ax.errorbar(xs, ys, xerr=exs, yerr=eys, marker="o", capsize=3, label=series_value)
+    for x, y, label in zip(xs, ys, labels):
+        if label:
+            ax.annotate(label, (x, y), textcoords="offset points", xytext=(4, 4), fontsize=7)
+
+
 def draw_chart(plan, rows, chart, path):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    x, y = chart["x"], chart["y"]
+    x, y = chart.get("x") or chart["x_metric"], chart["y"]
     series, facet = chart.get("series"), chart.get("facet")
     where = {k: [cell(v) for v in allowed] for k, allowed in chart.get("where", {}).items()}
     rows = [r for r in rows if all(cell(r["values"].get(k)) in allowed
@@ -120,7 +154,8 @@ def draw_chart(plan, rows, chart, path):
     done = [r for r in rows if r["status"] == "done"
             and isinstance(r["metrics"].get(y), (int, float))]
     every_x = ordered(cell(r["values"].get(x)) for r in rows)
-    numeric = all(isinstance(r["values"].get(x), (int, float)) for r in rows)
+    numeric = "x_metric" in chart or all(isinstance(r["values"].get(x), (int, float))
+                                         for r in rows)
     facets = ordered(cell(r["values"].get(facet)) for r in done) if facet else [None]
     fig, axes = plt.subplots(1, max(1, len(facets)), figsize=(4.6 * max(1, len(facets)), 3.6),
                              squeeze=False)
@@ -128,6 +163,9 @@ def draw_chart(plan, rows, chart, path):
         mine = [r for r in done if fv is None or cell(r["values"].get(facet)) == fv]
         for sv in ordered(cell(r["values"].get(series)) for r in mine) if series else [None]:
             points = [r for r in mine if sv is None or cell(r["values"].get(series)) == sv]
+            if "x_metric" in chart:
+                draw_metric_series(ax, points, chart, sv)
+                continue
             xs, ms, es = [], [], []
             for xv in every_x:
                 ys = [r["metrics"][y] for r in points if cell(r["values"].get(x)) == xv]
@@ -137,7 +175,7 @@ def draw_chart(plan, rows, chart, path):
                     ms.append(m)
                     es.append(e)
             ax.errorbar(xs, ms, yerr=es, marker="o", capsize=3, label=sv)
-        if not numeric:
+        if not numeric and "x_metric" not in chart:
             ax.set_xticks(range(len(every_x)), every_x, rotation=30)
         if chart.get("log_x"):
             ax.set_xscale("log")
@@ -157,8 +195,8 @@ def draw_chart(plan, rows, chart, path):
 
 
 def write_charts(plan, rows):
-    """The spec's charts (its "charts" list: x, y, series, facet, where, log_x, log_y, title,
-    file) as
+    """The spec's charts (its "charts" list: x or x_metric, y, series, facet, where, log_x, log_y,
+    title, file) as
     PNG files in OUT: the mean of y over the runs that differ in other keys (seeds, say), with
     its standard error. Returns their paths."""
     paths = []
