@@ -90,10 +90,7 @@ Prepared prepare(const RunSettings& s) {
                 ? fit_units(p.measured.data, p.measured.coordinates, p.measured.state_names)
                 : identity_units(p.measured.data.train_x.cols());
   p.truth = make_truth(p.config.hamiltonian, p.measured);
-  HNN_TASKS_CHECK(!p.measured.scattered || !s.loss.rollout,
-                  "{}: the rollout loss needs trajectories, and the file holds scattered states "
-                  "(no time column): use --loss derivative",
-                  p.measured.source);
+  if (p.measured.scattered) check_scattered_settings(s.task_settings, s.loss, p.measured.source);
   return p;
 }
 

@@ -147,6 +147,9 @@ TEST(ScatteredCli, RefusalsAreOneLineAndWriteNothing) {
       {train(csv, {"--split", "time"}),
        csv.string() + ": split by time needs trajectories, and the file holds scattered states (no "
                       "time column): leave the split at auto (the last rows are the test set)\n"},
+      {train(csv, {"--settings", "{\"rollouts\": 5}"}),
+       csv.string() + ": the setting rollouts needs trajectories, and the file holds scattered "
+                      "states (no time column): leave it out\n"},
       {train(csv, {"--loss", "rollout"}),
        csv.string() + ": the rollout loss needs trajectories, and the file holds scattered states "
                       "(no time column): use --loss derivative\n"},
