@@ -115,6 +115,9 @@ TEST(ScatteredTasks, TrainAFewStepsAndAreJudgedOnHeldOutPointsWithoutRollouts) {
     for (const char* absent : {"valid_prediction_time", "energy_mse", "rollouts", "state_mse"})
       EXPECT_FALSE(m.contains(absent)) << name << " has " << absent;
     EXPECT_FALSE(std::filesystem::exists(dir / "rollout.csv")) << name;
+    // `hnn rollout` on request, from test points over a span short enough for Hénon-Heiles'
+    // box, whose states mostly escape its well.
+    EXPECT_EQ(write_rollout(dir.path(), RolloutCommand{}).trajectories, 5) << name;
     EXPECT_EQ(testing::read_json(dir / "metrics.json")["hamiltonian_rel_l2"],
               m["hamiltonian_rel_l2"])
         << name;
