@@ -77,4 +77,19 @@ DataConfig data_config(const json& s) {
   return c;
 }
 
+void check_scattered_settings(const json& settings, const RolloutLossConfig& loss,
+                              const std::string& source) {
+  HNN_TASKS_CHECK(!loss.rollout,
+                  "{}: the rollout loss needs trajectories, and the file holds scattered states "
+                  "(no time column): use --loss derivative",
+                  source);
+  for (const char* key :
+       {"rollouts", "t_end", "energy_rollouts", "energy_t_end", "threshold", "gap_factor"}) {
+    HNN_TASKS_CHECK(!settings.contains(key),
+                    "{}: the setting {} needs trajectories, and the file holds scattered states "
+                    "(no time column): leave it out",
+                    source, key);
+  }
+}
+
 }  // namespace hnn::tasks

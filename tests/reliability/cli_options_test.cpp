@@ -153,7 +153,8 @@ TEST(CliOptions, BadCommandsAndOtherSubcommandsGetOneLine) {
        "Could not convert: --no-reversibility = x"},
       {{"reproduce", "--tasks", "spring,nope", "--out", (dir / "results").string()},
        "unknown task 'nope' (known: spring, pendulum, real-pendulum, two-body, three-body, "
-       "pixel-pendulum, damped-spring, double-pendulum, real-double-pendulum, data)"},
+       "pixel-pendulum, damped-spring, double-pendulum, real-double-pendulum, henon-heiles, "
+       "pendulum-scattered, double-pendulum-scattered, data)"},
       {{"reproduce", "--tasks", "data", "--out", (dir / "results").string()},
        "reproduce runs the paper's tasks (spring, pendulum, real-pendulum, two-body, three-body, "
        "pixel-pendulum); 'data' is not one of them: train it with hnn train data"},

@@ -1,6 +1,6 @@
 // The few lines `hnn train` and `hnn evaluate` print (summary.h), from metrics.json's keys: each
 // line is left out when a task has no such key (the pixel pendulum has no R^2, a data run without
-// a known H no energy MSE).
+// a known H no energy MSE, a run on scattered states no rollouts).
 
 #include "apps/hnn/commands/summary.h"
 
@@ -75,6 +75,24 @@ std::string prediction_line(const json& m) {
   return line + "\n";
 }
 
+// A run on scattered states: no rollouts to report, and the one line says so.
+std::string skipped_rollouts_line(const json& m) {
+  if (!m.contains("rollouts_skipped")) return "";
+  return "  rollouts   none: scattered states, no trajectories (no valid prediction time or "
+         "reversibility)\n";
+}
+
+// The learned H against the true one on the held-out points, up to H's constant.
+std::string hamiltonian_line(const json& m) {
+  const std::optional<double> error = number_at(m, "hamiltonian_rel_l2");
+  if (!error) return "";
+  std::string points;
+  if (const auto n = number_at(m, "hamiltonian_rel_l2_count"))
+    points = fmt::format(" on {:g} held-out points", *n);
+  return fmt::format("  H          relative L2 error {:.3g}{} (up to a constant)\n", *error,
+                     points);
+}
+
 // The energy error against the true H: absolute and relative; or why there is none.
 std::string energy_lines(const json& m) {
   std::string out;
@@ -107,8 +125,8 @@ std::string timing_line(const json& m) {
 }  // namespace
 
 std::string metrics_summary(const json& m) {
-  return heading_line(m) + "\n" + loss_lines(m) + prediction_line(m) + energy_lines(m) +
-         timing_line(m);
+  return heading_line(m) + "\n" + loss_lines(m) + prediction_line(m) + skipped_rollouts_line(m) +
+         hamiltonian_line(m) + energy_lines(m) + timing_line(m);
 }
 
 void print_warnings(const json& metrics) {
