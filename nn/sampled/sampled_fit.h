@@ -27,6 +27,18 @@ inline constexpr NameTable<HiddenSampler, 3> kHiddenSamplerNames{{
     {HiddenSampler::kAswim, "aswim"},
 }};
 
+/// How the last layer's least-squares problem is solved (docs/sampled.md has the measurements).
+enum class LeastSquaresSolver {
+  kLsqr,      // LSQR on A, right-preconditioned by the Cholesky factor of the regularised Gram
+  kCholesky,  // the regularised normal equations (A^T A + lambda I) c = A^T b, by Cholesky
+  kQr,        // LAPACK's dgelsd (SVD-based, like np.linalg.lstsq) on the formed A: the reference
+};
+inline constexpr NameTable<LeastSquaresSolver, 3> kLeastSquaresSolverNames{{
+    {LeastSquaresSolver::kLsqr, "lsqr"},
+    {LeastSquaresSolver::kCholesky, "cholesky"},
+    {LeastSquaresSolver::kQr, "qr"},
+}};
+
 /// Settings of a sampled fit. The defaults reproduce the peer's accuracy (docs/sampled.md).
 struct SampledFitConfig {
   HiddenSampler sampler = HiddenSampler::kUswim;
@@ -34,6 +46,13 @@ struct SampledFitConfig {
   /// np.linalg.lstsq rcond); each solver honours it in its own way (docs/sampled.md).
   double rcond = 1e-13;
   std::uint64_t seed = 0;
+  LeastSquaresSolver solver = LeastSquaresSolver::kLsqr;
+  /// lambda = regularization * mean(diag(A^T A)) for kCholesky and for kLsqr's preconditioner.
+  double regularization = 1e-12;
+  /// kLsqr stops when the normal-equation residual |A^T r| falls below tolerance * |A| |r|.
+  double tolerance = 1e-12;
+  /// kLsqr's iteration cap.
+  int max_iterations = 200;
 };
 
 /// What a fit did, for metrics.json and the closing figures.
