@@ -103,13 +103,7 @@ TEST(SampledFitCli, SampledThenAdamRunsItsStepsFromTheSampledWeights) {
 
 TEST(SampledFitCli, TheDataTaskFitsItsTrainingSplit) {
   const TempDir dir;
-  const std::string csv = (dir / "pend.csv").string();
-  ASSERT_EQ(
-      run_hnn({"simulate", "--hamiltonian", "p^2/2 + 2*(1 - cos(q))", "--coords", "q", "--momenta",
-               "p", "--trajectories", "10", "--t-end", "2", "--points", "15", "--out", csv},
-              dir.path())
-          .code,
-      0);
+  const std::string csv = simulated_pendulum_csv(dir.path());
   const Result r =
       run_hnn({"train", "data", "--data", csv, "--coords", "q", "--momenta", "p", "--fit",
                "sampled", "--hidden", "40", "--quiet", "--out", (dir / "run").string()},
