@@ -37,6 +37,13 @@ void check_sampled_options(const RunOptions& o) {
   }
 }
 
+nlohmann::json recorded_fit(const fs::path& run_dir) {
+  const RunFolder folder(run_dir);
+  std::error_code ec;
+  if (!fs::exists(folder.file("metrics.json"), ec)) return nullptr;
+  return folder.read_metrics().value("fit", nlohmann::json());
+}
+
 void check_not_sampled_run(const fs::path& run_dir) {
   const RunFolder folder(run_dir);
   std::error_code ec;

@@ -18,6 +18,11 @@ void check_fit_model(const FitConfig& fit, nn::ModelKind model, const std::strin
 /// sampled, which takes none.
 void check_sampled_options(const RunOptions& o);
 
+/// metrics.json's "fit" in `run_dir` (how its weights were sampled and solved), or null: no
+/// metrics.json, or a run of Adam alone. What a run evaluated again or continued with Adam
+/// (which does not sample again) keeps.
+nlohmann::json recorded_fit(const std::filesystem::path& run_dir);
+
 /// Throws Error when `run_dir` holds a run fitted with --fit sampled: it has no checkpoint, no
 /// steps to resume or continue.
 void check_not_sampled_run(const std::filesystem::path& run_dir);

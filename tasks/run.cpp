@@ -244,7 +244,9 @@ json run_training(const RunOptions& o) {
       fs::remove_all(entry.path());
   }
   folder.create();
-  const TrainResult trained = run->train(loop_options(o, settings, folder));
+  const json sampled_before = o.resume ? recorded_fit(o.out) : json();  // not sampled again
+  TrainResult trained = run->train(loop_options(o, settings, folder));
+  if (trained.fit.is_null()) trained.fit = sampled_before;
   run->save(folder.params_file());
   if (settings.fit.steps()) folder.write_loss_curve(trained.curve);  // --fit sampled: no steps
   json metrics = run_metrics(*run, folder, trained, settings);
@@ -283,8 +285,7 @@ json evaluate_run(const fs::path& run_dir, const std::string& data_file, bool wr
   json metrics = loaded.run->evaluate(write_files ? &folder : nullptr);
   metrics.update(loaded.settings.to_json());
   // How the weights were fitted, as trained: the summary says so beside the new figures.
-  if (const json trained = folder.read_metrics(); trained.contains("fit"))
-    metrics["fit"] = trained["fit"];
+  if (json fit = recorded_fit(run_dir); !fit.is_null()) metrics["fit"] = std::move(fit);
   metrics["warnings"] = run_warnings({}, metrics);
   return metrics;
 }

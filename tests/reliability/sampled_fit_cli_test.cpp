@@ -99,6 +99,15 @@ TEST(SampledFitCli, SampledThenAdamRunsItsStepsFromTheSampledWeights) {
   ASSERT_EQ(train_spring(dir, "adam", {"--steps", "20", "--lr", "1e-4", "--quiet"}).code, 0);
   EXPECT_LT(m.at("test_loss").get<double>(),
             read_json(dir / "adam" / "metrics.json").at("test_loss").get<double>() / 10);
+  // Continued with Adam from its checkpoint, not sampled again: the run keeps its fit's report.
+  const Result continued = run_hnn(
+      {"train", "--resume", (dir / "run").string(), "--steps", "30", "--quiet"}, dir.path());
+  ASSERT_EQ(continued.code, 0) << continued.err;
+  const json more = read_json(dir / "run" / "metrics.json");
+  EXPECT_EQ(more.at("steps"), 30);
+  EXPECT_EQ(more.at("fit"), m.at("fit"));
+  EXPECT_NE(continued.out.find("sampled fit (uswim), then Adam 30 steps"), std::string::npos)
+      << continued.out;
 }
 
 TEST(SampledFitCli, TheDataTaskFitsItsTrainingSplit) {
