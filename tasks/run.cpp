@@ -238,14 +238,18 @@ json run_training(const RunOptions& o) {
   const double data_seconds = seconds_since(start);
   record_data_file(settings);
   const RunFolder folder(o.out);
-  // After the data: bad data leave the folder as it was, or no folder.
+  const json sampled_before = o.resume ? recorded_fit(o.out) : json();  // not sampled again
+  // --fit sampled writes nothing while it runs: a fit that fails leaves the folder as it was.
+  const bool sampled_only = !settings.fit.steps();
+  TrainResult trained;
+  if (sampled_only) trained = run->train(loop_options(o, settings, folder));
+  // After the data (and a sampled fit): bad data leave the folder as it was, or no folder.
   if (o.force && !o.resume && fs::is_directory(o.out)) {
     for (const fs::directory_entry& entry : fs::directory_iterator(o.out))
       fs::remove_all(entry.path());
   }
   folder.create();
-  const json sampled_before = o.resume ? recorded_fit(o.out) : json();  // not sampled again
-  TrainResult trained = run->train(loop_options(o, settings, folder));
+  if (!sampled_only) trained = run->train(loop_options(o, settings, folder));
   if (trained.fit.is_null()) trained.fit = sampled_before;
   run->save(folder.params_file());
   if (settings.fit.steps()) folder.write_loss_curve(trained.curve);  // --fit sampled: no steps

@@ -120,6 +120,9 @@ std::vector<BadOption> bad_fit_options() {
        "gives it (models it fits: hnn, baseline, dhnn)"},
       {{"train", "spring", "--hidden", "5000"},
        "--hidden 5000 is wider than Adam trains (4096 at most); --fit sampled takes up to 8192"},
+      {{"train", "spring", "--fit", "sampled", "--model", "baseline", "--hidden", "1000"},
+       "spring: sampled fit: 1000 last-layer unknowns per output but only 750 equations from 750 "
+       "points; lower the width or give more points"},
       {{"train", "spring", "--fit", "sgd"}, "--fit: sgd not in {adam,sampled,sampled+adam}"},
       {{"train", "spring", "--fit", "sampled", "--sampler", "gauss"},
        "--sampler: gauss not in {elm,uswim,aswim}"},

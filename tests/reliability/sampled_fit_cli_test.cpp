@@ -74,6 +74,11 @@ TEST(SampledFitCli, ASampledSpringHnnIsAnOrdinaryRunFolderThatKeepsTheEnergyAdva
       dir.path());
   EXPECT_EQ(exported.code, 0) << exported.err;
   EXPECT_TRUE(fs::exists(dir / "h.json"));
+  // A fit that fails (too wide for the 750 training states) leaves the run it would replace.
+  const Result too_wide = train_spring(
+      dir, "hnn", {"--fit", "sampled", "--model", "baseline", "--hidden", "1000", "--force"});
+  EXPECT_EQ(too_wide.code, 1);
+  EXPECT_EQ(read_json(dir / "hnn" / "metrics.json"), m);
   // No steps to resume or continue.
   const Result resumed = run_hnn({"train", "--resume", (dir / "hnn").string()}, dir.path());
   EXPECT_EQ(resumed.code, 1);
