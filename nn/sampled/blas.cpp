@@ -37,16 +37,16 @@ void blas_gram(const double* a, Eigen::Index rows, Eigen::Index cols, Eigen::Ind
   g.triangularView<Eigen::StrictlyUpper>() = g.transpose();
 }
 
-bool cholesky_lower(ColMat& g) {
+bool cholesky_upper(ColMat& g) {
   const auto n = int(g.rows());
   int info = 0;
-  dpotrf_("L", &n, g.data(), &n, &info);
+  dpotrf_("U", &n, g.data(), &n, &info);
   return info == 0;
 }
 
-void solve_lower(const ColMat& l, bool transpose, ColMat& y) {
-  cblas_dtrsm(CblasColMajor, CblasLeft, CblasLower, transpose ? CblasTrans : CblasNoTrans,
-              CblasNonUnit, int(y.rows()), int(y.cols()), 1.0, l.data(), int(l.rows()), y.data(),
+void solve_upper(const ColMat& r, bool transpose, ColMat& y) {
+  cblas_dtrsm(CblasColMajor, CblasLeft, CblasUpper, transpose ? CblasTrans : CblasNoTrans,
+              CblasNonUnit, int(y.rows()), int(y.cols()), 1.0, r.data(), int(r.rows()), y.data(),
               int(y.rows()));
 }
 

@@ -25,10 +25,10 @@ void blas_gemm(const ColMat& a, bool ta, const ColMat& b, bool tb, ColMat& c, do
 /// lda), both triangles filled: one dsyrk, the floor of the normal-equation solvers.
 void blas_gram(const double* a, Eigen::Index rows, Eigen::Index cols, Eigen::Index lda, ColMat& g,
                double beta);
-/// g = L L^T in place (the lower triangle holds L); false when g is not positive definite.
-bool cholesky_lower(ColMat& g);
-/// y <- L^-T y (transpose) or y <- L^-1 y, for the lower-triangular factor of cholesky_lower.
-void solve_lower(const ColMat& l, bool transpose, ColMat& y);
+/// g = R^T R in place (the upper triangle holds R); false when g is not positive definite.
+bool cholesky_upper(ColMat& g);
+/// y <- R^-1 y, or y <- R^-T y (transpose), for an upper-triangular R.
+void solve_upper(const ColMat& r, bool transpose, ColMat& y);
 /// min |a x - b| by LAPACK's dgelsd (the SVD solver np.linalg.lstsq runs); singular values below
 /// rcond times the largest are dropped. a is destroyed; b (rows x m) returns x in its first
 /// a.cols() rows. Returns the effective rank; throws std::runtime_error when dgelsd fails.

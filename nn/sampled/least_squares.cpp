@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 namespace hnn::nn::sampled {
@@ -12,52 +13,89 @@ using Eigen::Index;
 
 namespace {
 
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-// The Cholesky factor L of A^T A + lambda I, lambda = regularization * mean(diag(A^T A)).
-void factor_regularised(ColMat& g, double regularization) {
-  const double lambda = regularization * g.diagonal().mean();
-  g.diagonal().array() += lambda;
-  if (!cholesky_lower(g)) {
-    throw std::invalid_argument(
-        fmt::format("sampled fit: the last layer's normal matrix is singular (Cholesky failed at "
-                    "regularisation {:g}); raise the regularisation or lower the width",
-                    regularization));
+// The right preconditioner c = S R^-1 y: R upper triangular, S a column scaling.
+struct Preconditioner {
+  ColMat r;
+  Eigen::VectorXd s;
+
+  void apply(ColMat y, ColMat& c) const {  // c = S R^-1 y
+    solve_upper(r, false, y);
+    c = s.asDiagonal() * y;
   }
+  void apply_t(const ColMat& c, ColMat& y) const {  // y = R^-T S c
+    y = s.asDiagonal() * c;
+    solve_upper(r, true, y);
+  }
+};
+
+// The normal equations' factor: columns scaled to unit norm (s = diag(A^T A)^-1/2: SWIM's
+// neurons differ in slope by orders of magnitude), then R^T R = S A^T A S + lambda I, lambda
+// raised tenfold while the factorisation fails (the scaled Gram's rounding is about 1e-16, so
+// a lambda near it may not make the computed matrix positive definite).
+constexpr double kLargestRegularization = 1e-6;
+
+Preconditioner cholesky_preconditioner(const ColMat& gram, double regularization, double& used) {
+  const Index p = gram.rows();
+  for (Index j = 0; j < p; ++j) {
+    if (!(gram(j, j) > 0)) {
+      throw std::invalid_argument(fmt::format(
+          "sampled fit: the last layer's system is singular: unknown {} (neuron {}) has no "
+          "equation (its input gradient is zero at every data point)",
+          j, j));
+    }
+  }
+  Preconditioner m{ColMat(p, p), {}};
+  m.s = gram.diagonal().cwiseMax(std::numeric_limits<double>::min()).cwiseSqrt().cwiseInverse();
+  for (used = regularization; used <= kLargestRegularization; used *= 10) {
+    m.r = m.s.asDiagonal() * gram * m.s.asDiagonal();
+    m.r.diagonal().array() += used;
+    if (cholesky_upper(m.r)) {
+      m.r.triangularView<Eigen::StrictlyLower>().setZero();
+      return m;
+    }
+    if (used == 0) used = 1e-16;
+  }
+  throw std::invalid_argument(
+      fmt::format("sampled fit: the last layer's normal matrix is singular (Cholesky failed up to "
+                  "regularisation {:g}); lower the width or give more distinct points",
+                  kLargestRegularization));
 }
 
-// LSQR (Paige & Saunders 1982) on A L^-T, started from c0: it solves for the correction, and
-// the preconditioned matrix is well conditioned where A's singular values exceed sqrt(lambda),
-// so it converges in a few iterations there; smaller ones it resolves slowly, which stopping
-// early turns into a truncation like rcond's.
+// LSQR (Paige & Saunders 1982) on A M (M the preconditioner), started from c: it solves for the
+// correction, and returns the iterations.
 struct Lsqr {
   const LinearSystem& a;
-  const ColMat& l;
+  const Preconditioner& m;
   ColMat u, v, w, x, av, atu;
 
-  Lsqr(const LinearSystem& system, const ColMat& factor)
+  ColMat c_space;  // a vector of unknowns (M's output)
+
+  Lsqr(const LinearSystem& system, const Preconditioner& preconditioner)
       : a(system),
-        l(factor),
+        m(preconditioner),
         u(system.equations(), system.rhs_columns()),
-        v(system.unknowns(), system.rhs_columns()),
+        v(preconditioner.r.rows(), system.rhs_columns()),
         w(v),
         x(v),
         av(u),
-        atu(v) {}
+        atu(v),
+        c_space(system.unknowns(), system.rhs_columns()) {}
 
-  void forward(const ColMat& y, ColMat& out) {  // out = A L^-T y
-    atu = y;
-    solve_lower(l, true, atu);
-    a.apply(atu, out);
+  void forward(const ColMat& y, ColMat& out) {  // out = A M y
+    m.apply(y, c_space);
+    a.apply(c_space, out);
   }
-  void backward(const ColMat& r, ColMat& out) {  // out = L^-1 A^T r
-    a.apply_t(r, out);
-    solve_lower(l, false, out);
+  void backward(const ColMat& r, ColMat& out) {  // out = M^T A^T r
+    a.apply_t(r, c_space);
+    m.apply_t(c_space, out);
   }
 
-  // Returns the iterations; c += L^-T x.
   int run(ColMat& c, double tolerance, int max_iterations) {
     a.apply(c, u);
     u = a.rhs() - u;
@@ -89,13 +127,11 @@ struct Lsqr {
       phibar = sn * phibar;
       x += (phi / rho) * w;
       w = v - (theta / rho) * w;
-      // |(A L^-T)^T r| = phibar alpha |cs|, against |A L^-T| |r| (Paige & Saunders' test 2).
-      if (phibar * alpha * std::abs(cs) <= tolerance * std::sqrt(anorm2) * phibar || alpha == 0) {
-        break;
-      }
+      // |(A M)^T r| = phibar alpha |cs| against |A M| |r| (Paige & Saunders' test 2).
+      if (alpha * std::abs(cs) <= tolerance * std::sqrt(anorm2) || alpha == 0) break;
     }
-    solve_lower(l, true, x);
-    c += x;
+    m.apply(x, c_space);
+    c += c_space;
     return it;
   }
 };
@@ -107,6 +143,19 @@ void check_finite(const ColMat& c) {
   }
 }
 
+// dgelsd on the formed matrix: the reference, at the memory of A itself.
+void solve_by_svd(const LinearSystem& system, double rcond, LeastSquaresResult& out) {
+  auto start = Clock::now();
+  ColMat a = system.formed();
+  ColMat b = system.rhs();
+  out.gram_seconds = seconds_since(start);
+  out.bytes = std::size_t(a.size() + b.size()) * sizeof(double);
+  start = Clock::now();
+  lstsq_svd(a, b, rcond);
+  out.c = b.topRows(system.unknowns());
+  out.solve_seconds = seconds_since(start);
+}
+
 }  // namespace
 
 LeastSquaresResult solve_least_squares(const LinearSystem& system, const SampledFitConfig& config) {
@@ -114,31 +163,25 @@ LeastSquaresResult solve_least_squares(const LinearSystem& system, const Sampled
   LeastSquaresResult out;
   const Index p = system.unknowns();
   if (config.solver == LeastSquaresSolver::kQr) {
-    auto start = std::chrono::steady_clock::now();
-    ColMat a = system.formed();
-    ColMat b = system.rhs();
-    out.gram_seconds = seconds_since(start);
-    out.bytes = std::size_t(a.size() + b.size()) * sizeof(double);
-    start = std::chrono::steady_clock::now();
-    lstsq_svd(a, b, config.rcond);
-    out.c = b.topRows(p);
-    out.solve_seconds = seconds_since(start);
+    solve_by_svd(system, config.rcond, out);
   } else {
-    auto start = std::chrono::steady_clock::now();
+    auto start = Clock::now();
     ColMat g(p, p);
     system.gram(g);
     ColMat atb(p, system.rhs_columns());
     system.apply_t(system.rhs(), atb);
     out.gram_seconds = seconds_since(start);
     out.bytes = std::size_t(g.size()) * sizeof(double);
-    start = std::chrono::steady_clock::now();
-    factor_regularised(g, config.regularization);
-    out.c = atb;
-    solve_lower(g, false, out.c);
-    solve_lower(g, true, out.c);
+    start = Clock::now();
+    const Preconditioner m = cholesky_preconditioner(g, config.regularization, out.regularization);
+    g = ColMat();  // the factor is a copy: the Gram's memory goes back before LSQR allocates
+    ColMat y(p, atb.cols());
+    m.apply_t(atb, y);
+    out.c.resize(p, atb.cols());
+    m.apply(y, out.c);
     check_finite(out.c);
     if (config.solver == LeastSquaresSolver::kLsqr) {
-      Lsqr lsqr(system, g);
+      Lsqr lsqr(system, m);
       out.bytes += std::size_t(lsqr.u.size() * 2 + lsqr.v.size() * 4) * sizeof(double);
       out.iterations = lsqr.run(out.c, config.tolerance, config.max_iterations);
     }

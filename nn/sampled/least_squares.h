@@ -13,8 +13,9 @@ struct LeastSquaresResult {
   double gram_seconds = 0;   // A^T A (part of forming what the solver reads)
   double solve_seconds = 0;  // factorisation and iterations
   int iterations = 0;
-  double residual_rms = 0;  // |A c - B| / sqrt(equations * m)
-  std::size_t bytes = 0;    // the solver's own matrices
+  double regularization = 0;  // the lambda the Cholesky factorisation took
+  double residual_rms = 0;    // |A c - B| / sqrt(equations * m)
+  std::size_t bytes = 0;      // the solver's own matrices
 };
 
 /// Solves min |A C - B| by config.solver; throws std::invalid_argument when the system is

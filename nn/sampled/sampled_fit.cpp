@@ -126,8 +126,10 @@ Fitted fit_once(const DynamicsConfig& mc, const ColMat& x, const ColMat& dxdt,
   }
   const sampled::LeastSquaresResult solved = sampled::solve_least_squares(*system, config);
   report.assemble_seconds += solved.gram_seconds;
+  report.gram_seconds += solved.gram_seconds;
   report.solve_seconds += solved.solve_seconds;
   report.iterations = solved.iterations;
+  report.regularization = solved.regularization;
   report.residual_rms = solved.residual_rms;
   report.matrix_bytes = std::max(report.matrix_bytes, system->bytes() + solved.bytes);
   fit.c = solved.c;

@@ -29,7 +29,8 @@ inline constexpr NameTable<HiddenSampler, 3> kHiddenSamplerNames{{
 
 /// How the last layer's least-squares problem is solved (docs/sampled.md has the measurements).
 enum class LeastSquaresSolver {
-  kLsqr,      // LSQR on A, right-preconditioned by the Cholesky factor of the regularised Gram
+  kLsqr,      // LSQR on A, right-preconditioned by the Cholesky factor of the regularised Gram,
+              // started from the normal equations' solution
   kCholesky,  // the regularised normal equations (A^T A + lambda I) c = A^T b, by Cholesky
   kQr,        // LAPACK's dgelsd (SVD-based, like np.linalg.lstsq) on the formed A: the reference
 };
@@ -47,10 +48,12 @@ struct SampledFitConfig {
   double rcond = 1e-13;
   std::uint64_t seed = 0;
   LeastSquaresSolver solver = LeastSquaresSolver::kLsqr;
-  /// lambda = regularization * mean(diag(A^T A)) for kCholesky and for kLsqr's preconditioner.
-  double regularization = 1e-12;
+  /// lambda, added to the diagonal of A^T A after its columns are scaled to unit norm, for
+  /// kCholesky and kLsqr's preconditioner. When the Cholesky factorisation fails, lambda is
+  /// raised tenfold until it succeeds (at most to 1e-6; beyond, the system is called singular).
+  double regularization = 1e-13;
   /// kLsqr stops when the normal-equation residual |A^T r| falls below tolerance * |A| |r|.
-  double tolerance = 1e-12;
+  double tolerance = 1e-14;
   /// kLsqr's iteration cap.
   int max_iterations = 200;
 };
@@ -61,6 +64,8 @@ struct SampledFitReport {
   double sample_seconds = 0;     // drawing the hidden layers
   double assemble_seconds = 0;   // forming the matrices the solver reads
   double solve_seconds = 0;      // the solve itself
+  double gram_seconds = 0;       // of assemble_seconds: A^T A (one syrk), or forming A for qr
+  double regularization = 0;     // the lambda the Cholesky factorisation took (kLsqr, kCholesky)
   std::size_t rows = 0;          // equations of the least-squares problem
   std::size_t columns = 0;       // unknowns (last-layer weights)
   std::size_t matrix_bytes = 0;  // the largest matrices held at once
