@@ -12,6 +12,11 @@
 // LAPACK's Fortran entry points (OpenBLAS carries them; Debian ships no lapacke.h beside it).
 extern "C" {
 void dpotrf_(const char* uplo, const int* n, double* a, const int* lda, int* info);
+void dgeqrf_(const int* m, const int* n, double* a, const int* lda, double* tau, double* work,
+             const int* lwork, int* info);
+void dormqr_(const char* side, const char* trans, const int* m, const int* n, const int* k,
+             const double* a, const int* lda, const double* tau, double* c, const int* ldc,
+             double* work, const int* lwork, int* info);
 void dgelsd_(const int* m, const int* n, const int* nrhs, double* a, const int* lda, double* b,
              const int* ldb, double* s, const double* rcond, int* rank, double* work,
              const int* lwork, int* iwork, int* info);
@@ -42,6 +47,28 @@ bool cholesky_upper(ColMat& g) {
   int info = 0;
   dpotrf_("U", &n, g.data(), &n, &info);
   return info == 0;
+}
+
+ColMat qr_apply(ColMat& a, ColMat& b) {
+  const auto m = int(a.rows()), n = int(a.cols()), nrhs = int(b.cols());
+  std::vector<double> tau(static_cast<std::size_t>(n));
+  int info = 0, lwork = -1;
+  double query = 0;
+  dgeqrf_(&m, &n, a.data(), &m, tau.data(), &query, &lwork, &info);
+  lwork = int(query);
+  dormqr_("L", "T", &m, &nrhs, &n, a.data(), &m, tau.data(), b.data(), &m, &query, &lwork, &info);
+  lwork = std::max(lwork, int(query));
+  std::vector<double> work(std::size_t(std::max(lwork, 1)));
+  dgeqrf_(&m, &n, a.data(), &m, tau.data(), work.data(), &lwork, &info);
+  if (info == 0) {
+    dormqr_("L", "T", &m, &nrhs, &n, a.data(), &m, tau.data(), b.data(), &m, work.data(), &lwork,
+            &info);
+  }
+  if (info != 0) {
+    throw std::runtime_error(
+        fmt::format("sampled fit: LAPACK dgeqrf/dormqr failed (info {})", info));
+  }
+  return a.topRows(n).triangularView<Eigen::Upper>();
 }
 
 void solve_upper(const ColMat& r, bool transpose, ColMat& y) {

@@ -27,6 +27,8 @@ void blas_gram(const double* a, Eigen::Index rows, Eigen::Index cols, Eigen::Ind
                double beta);
 /// g = R^T R in place (the upper triangle holds R); false when g is not positive definite.
 bool cholesky_upper(ColMat& g);
+/// a = QR in place (Householder, LAPACK's dgeqrf), then b <- Q^T b; returns R (a.cols() square).
+ColMat qr_apply(ColMat& a, ColMat& b);
 /// y <- R^-1 y, or y <- R^-T y (transpose), for an upper-triangular R.
 void solve_upper(const ColMat& r, bool transpose, ColMat& y);
 /// min |a x - b| by LAPACK's dgelsd (the SVD solver np.linalg.lstsq runs); singular values below

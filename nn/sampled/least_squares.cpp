@@ -143,11 +143,12 @@ void check_finite(const ColMat& c) {
   }
 }
 
-// dgelsd on the formed matrix: the reference, at the memory of A itself.
+// dgelsd on the formed matrix (or the Hadamard form's reduction, dim times shorter): the
+// reference, at the memory of A (of D and the reduction).
 void solve_by_svd(const LinearSystem& system, double rcond, LeastSquaresResult& out) {
   auto start = Clock::now();
-  ColMat a = system.formed();
-  ColMat b = system.rhs();
+  ColMat a, b;
+  system.reduced(a, b);
   out.gram_seconds = seconds_since(start);
   out.bytes = std::size_t(a.size() + b.size()) * sizeof(double);
   start = Clock::now();

@@ -59,22 +59,23 @@ void check_inputs(const DynamicsConfig& config, const Matrix<double>& x,
 // The hidden layers and the last layer's weights (unknowns x m) of one fit.
 struct Fitted {
   std::vector<HiddenLayer> layers;
-  ColMat last_hidden;  // the last hidden layer's outputs at the data (N x width)
+  ColMat last_hidden;  // the last hidden layer's outputs at the data (N x width), when kept
   ColMat c;
 };
 
 std::vector<HiddenLayer> sample_hidden(const DynamicsConfig& mc, const ColMat& x,
                                        HiddenSampler sampler, const ColMat* target,
-                                       std::mt19937_64& rng, ColMat& last_hidden) {
+                                       std::mt19937_64& rng, ColMat* last_hidden) {
   std::vector<HiddenLayer> layers;
   ColMat h = sampled::mlp_input(mc, x);
   for (Index width : mc.hidden) {
     layers.push_back(sampled::sample_layer(h, width, sampler, mc.activation, target, rng));
+    if (layers.size() == mc.hidden.size() && !last_hidden) break;
     ColMat value;
     sampled::activate(mc.activation, sampled::pre_activation(layers.back(), h), value, nullptr);
     h.swap(value);
   }
-  last_hidden.swap(h);
+  if (last_hidden) last_hidden->swap(h);
   return layers;
 }
 
@@ -106,12 +107,13 @@ std::unique_ptr<sampled::LinearSystem> last_layer_system(const DynamicsConfig& m
   return std::make_unique<sampled::HadamardSystem>(std::move(slope), std::move(v), dxdt);
 }
 
+// keep_last: the last hidden layer's outputs are needed (the baseline's matrix, A-SWIM's target).
 Fitted fit_once(const DynamicsConfig& mc, const ColMat& x, const ColMat& dxdt,
                 const SampledFitConfig& config, HiddenSampler sampler, const ColMat* target,
-                std::mt19937_64& rng, SampledFitReport& report) {
+                bool keep_last, std::mt19937_64& rng, SampledFitReport& report) {
   Fitted fit;
   auto start = Clock::now();
-  fit.layers = sample_hidden(mc, x, sampler, target, rng, fit.last_hidden);
+  fit.layers = sample_hidden(mc, x, sampler, target, rng, keep_last ? &fit.last_hidden : nullptr);
   report.sample_seconds += seconds_from(start);
   start = Clock::now();
   const auto system = last_layer_system(mc, fit, x, dxdt);
@@ -146,7 +148,7 @@ ColMat fitted_outputs(const Fitted& fit) {
 template <typename T>
 void write_weights(DynamicsModel<T>& model, const Fitted& fit) {
   const auto hidden = Index(fit.layers.size());
-  const Index w = fit.last_hidden.cols();
+  const Index w = fit.layers.back().w.cols();
   const ColMat last = fit.c.cols() > 1 ? fit.c : ColMat(fit.c.col(0).reshaped(w, fit.c.rows() / w));
   model.visit_parameters([&](const std::string& name, ad::Var<T>& p) {
     for (Index l = 0; l <= hidden; ++l) {
@@ -172,11 +174,12 @@ SampledFitReport fit_sampled(DynamicsModel<T>& model, const Matrix<double>& x,
   const ColMat xc = x, dc = dxdt;
   std::mt19937_64 rng(config.seed);
   const bool adaptive = config.sampler == HiddenSampler::kAswim;
+  const bool baseline = mc.model == ModelKind::kBaseline;
   Fitted fit = fit_once(mc, xc, dc, config, adaptive ? HiddenSampler::kUswim : config.sampler,
-                        nullptr, rng, report);
+                        nullptr, baseline || adaptive, rng, report);
   if (adaptive) {
     const ColMat approximate = fitted_outputs(fit);
-    fit = fit_once(mc, xc, dc, config, HiddenSampler::kAswim, &approximate, rng, report);
+    fit = fit_once(mc, xc, dc, config, HiddenSampler::kAswim, &approximate, baseline, rng, report);
   }
   write_weights(model, fit);
   return report;

@@ -87,6 +87,22 @@ ColMat HadamardSystem::formed() const {
   return a;
 }
 
+void HadamardSystem::reduced(ColMat& a, ColMat& b) const {
+  const Index n = d_.rows(), w = d_.cols(), dim = v_.rows();
+  ColMat q = d_;
+  ColMat qtb = b_.reshaped(n, dim);
+  const ColMat r = qr_apply(q, qtb);
+  q = ColMat();
+  a.resize(dim * w, v_.cols());
+  b.resize(dim * w, 1);
+  for (Index i = 0; i < dim; ++i) {
+    for (Index col = 0; col < v_.cols(); ++col) {
+      a.col(col).segment(i * w, w) = r.col(col % w) * v_(i, col);
+    }
+    b.col(0).segment(i * w, w) = qtb.col(i).head(w);
+  }
+}
+
 std::size_t HadamardSystem::bytes() const {
   return std::size_t(d_.size() + v_.size() + b_.size() + y_.size() + q_.size() + p_.size()) *
          sizeof(double);

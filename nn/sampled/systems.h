@@ -22,8 +22,14 @@ class LinearSystem {
   /// out = A c (equations x m) and out = A^T r (unknowns x m), out already sized.
   virtual void apply(const ColMat& c, ColMat& out) const = 0;
   virtual void apply_t(const ColMat& r, ColMat& out) const = 0;
-  /// A itself, equations x unknowns (the reference solver's input, and the tests').
+  /// A itself, equations x unknowns (the tests').
   virtual ColMat formed() const = 0;
+  /// a and b with the least-squares problem of A and B (the same solutions, the residual
+  /// smaller by a constant): the SVD solver's input. A and B themselves unless overridden.
+  virtual void reduced(ColMat& a, ColMat& b) const {
+    a = formed();
+    b = rhs();
+  }
   /// Bytes of the matrices the system holds.
   virtual std::size_t bytes() const = 0;
 };
@@ -60,6 +66,9 @@ class HadamardSystem final : public LinearSystem {
   void apply(const ColMat& c, ColMat& out) const override;
   void apply_t(const ColMat& r, ColMat& out) const override;
   ColMat formed() const override;
+  /// With D = QR (N x width): row block i becomes R diag(v_i), its targets the first width
+  /// entries of Q^T b_i, as Q is the same for every block: dim * width rows instead of dim * N.
+  void reduced(ColMat& a, ColMat& b) const override;
   std::size_t bytes() const override;
 
  private:

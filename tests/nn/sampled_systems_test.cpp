@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/QR>
+
 #include "nn/sampled/features.h"
 #include "nn/sampled/systems.h"
 
@@ -27,6 +29,13 @@ TEST(SampledSystems, HadamardGramEqualsTheFormedNormalMatrix) {
     EXPECT_LT((ac - a * c).norm(), 1e-13 * ac.norm());
     system.apply_t(system.rhs(), atr);
     EXPECT_LT((atr - a.transpose() * system.rhs()).norm(), 1e-13 * atr.norm());
+    // The reduction has A's least-squares solution.
+    ColMat ra, rb;
+    system.reduced(ra, rb);
+    ASSERT_EQ(ra.rows(), dim * w);
+    const ColMat want_c = a.colPivHouseholderQr().solve(system.rhs());
+    const ColMat got_c = ra.colPivHouseholderQr().solve(rb);
+    EXPECT_LT((got_c - want_c).norm(), 1e-10 * want_c.norm());
     // Row i * n + k of A is field coordinate i at point k: D row k scaled by v_i.
     EXPECT_DOUBLE_EQ(a(2 * n + 5, 3), d(5, 3) * v(2, 3));
     EXPECT_DOUBLE_EQ(system.rhs()(2 * n + 5, 0), dxdt(5, 2));
