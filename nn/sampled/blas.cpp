@@ -53,12 +53,11 @@ ColMat qr_apply(ColMat& a, ColMat& b) {
   const auto m = int(a.rows()), n = int(a.cols()), nrhs = int(b.cols());
   std::vector<double> tau(static_cast<std::size_t>(n));
   int info = 0, lwork = -1;
-  double query = 0;
-  dgeqrf_(&m, &n, a.data(), &m, tau.data(), &query, &lwork, &info);
-  lwork = int(query);
-  dormqr_("L", "T", &m, &nrhs, &n, a.data(), &m, tau.data(), b.data(), &m, &query, &lwork, &info);
-  lwork = std::max(lwork, int(query));
-  std::vector<double> work(std::size_t(std::max(lwork, 1)));
+  double query_qr = 0, query_q = 0;  // workspace queries (lwork -1)
+  dgeqrf_(&m, &n, a.data(), &m, tau.data(), &query_qr, &lwork, &info);
+  dormqr_("L", "T", &m, &nrhs, &n, a.data(), &m, tau.data(), b.data(), &m, &query_q, &lwork, &info);
+  lwork = std::max(1, int(std::max(query_qr, query_q)));
+  std::vector<double> work(static_cast<std::size_t>(lwork));
   dgeqrf_(&m, &n, a.data(), &m, tau.data(), work.data(), &lwork, &info);
   if (info == 0) {
     dormqr_("L", "T", &m, &nrhs, &n, a.data(), &m, tau.data(), b.data(), &m, work.data(), &lwork,

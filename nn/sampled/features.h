@@ -20,7 +20,7 @@ struct HiddenLayer {
 /// the angles, sin of the angles, the other coordinates), as DynamicsModel::mlp_input.
 ColMat mlp_input(const DynamicsConfig& config, const ColMat& x);
 
-/// act(z) and act'(z) of the activation, elementwise; `slope` may be null.
+/// act(z) and act'(z) of the activation, elementwise; `slope` may be null, `value` may be z.
 void activate(Activation activation, const ColMat& z, ColMat& value, ColMat* slope);
 
 /// The pre-activation u w + b of a layer.

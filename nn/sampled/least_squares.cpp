@@ -24,12 +24,14 @@ struct Preconditioner {
   ColMat r;
   Eigen::VectorXd s;
 
-  void apply(ColMat y, ColMat& c) const {  // c = S R^-1 y
-    solve_upper(r, false, y);
-    c = s.asDiagonal() * y;
+  void apply(const ColMat& y, ColMat& c) const {  // c = S R^-1 y, in c's own memory
+    c = y;
+    solve_upper(r, false, c);
+    c.array().colwise() *= s.array();
   }
   void apply_t(const ColMat& c, ColMat& y) const {  // y = R^-T S c
-    y = s.asDiagonal() * c;
+    y = c;
+    y.array().colwise() *= s.array();
     solve_upper(r, true, y);
   }
 };

@@ -21,7 +21,7 @@ std::size_t DenseSystem::bytes() const {
 HadamardSystem::HadamardSystem(ColMat d, ColMat v, const ColMat& dxdt)
     : d_(std::move(d)), v_(std::move(v)), b_(dxdt.size(), 1) {
   b_ = dxdt.reshaped();  // column-major: coordinate i's targets, then i + 1's
-  y_.resize(d_.cols(), v_.rows());
+  y_.resize(v_.rows(), d_.cols());
   q_.resize(d_.cols(), v_.rows());
   p_.resize(d_.rows(), v_.rows());
 }
@@ -54,18 +54,20 @@ void HadamardSystem::apply(const ColMat& c, ColMat& out) const {
   y_.setZero();
   for (Index i = 0; i < dim; ++i) {
     for (Index s = 0; s < blocks; ++s) {
-      y_.col(i).array() +=
-          v_.row(i).segment(s * w, w).transpose().array() * c.col(0).segment(s * w, w).array();
+      y_.row(i).array() +=
+          v_.row(i).segment(s * w, w).array() * c.col(0).segment(s * w, w).transpose().array();
     }
   }
-  blas_gemm(d_, false, y_, false, p_);
-  out.col(0) = p_.reshaped();
+  // D (Y^T)^T, not D Y: OpenBLAS 0.3.21's small-matrix kernel for a narrow right-hand side
+  // mallocs on every call (autodiff/gemm.h), and LSQR calls this every iteration.
+  blas_gemm(d_, false, y_, true, p_);
+  out.col(0) = Eigen::Map<const Eigen::VectorXd>(p_.data(), p_.size());
 }
 
 // A^T r: block s of the result is sum_i v_is o (D^T r_i).
 void HadamardSystem::apply_t(const ColMat& r, ColMat& out) const {
   const Index w = d_.cols(), blocks = v_.cols() / w, dim = v_.rows();
-  p_ = r.col(0).reshaped(d_.rows(), dim);
+  p_ = Eigen::Map<const ColMat>(r.data(), d_.rows(), dim);
   blas_gemm(d_, true, p_, false, q_);
   out.setZero();
   for (Index s = 0; s < blocks; ++s) {

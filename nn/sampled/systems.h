@@ -73,7 +73,7 @@ class HadamardSystem final : public LinearSystem {
 
  private:
   ColMat d_, v_, b_;          // b_: N * dim x 1, coordinate-major (row i * N + n)
-  mutable ColMat y_, q_, p_;  // apply's and apply_t's work matrices, allocated once
+  mutable ColMat y_, q_, p_;  // apply's (y_: dim x width) and apply_t's work, allocated once
 };
 
 }  // namespace hnn::nn::sampled

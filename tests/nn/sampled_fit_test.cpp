@@ -8,6 +8,7 @@
 #include <functional>
 #include <random>
 
+#include "malloc_counter.h"
 #include "nn/hnn.h"
 
 namespace hnn::nn {
@@ -194,6 +195,24 @@ TEST(SampledFit, SingularSystemIsRefused) {
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("singular"), std::string::npos) << e.what();
   }
+}
+
+// The fit allocates its matrices once: LSQR's iterations allocate nothing, so a fit of 25
+// iterations makes as many allocations as one of 5.
+TEST(SampledFit, LsqrIterationsAllocateNothing) {
+  if (!HNN_COUNTS_ALLOCATIONS) GTEST_SKIP() << "allocations are not counted here";
+  const Problem train = pendulum(300, 2);
+  auto allocations = [&](int iterations) {
+    std::mt19937_64 rng(1);
+    auto model = make_model<double>(model_config(ModelKind::kHnn, {60}), rng);
+    const SampledFitConfig fit{.tolerance = 0, .max_iterations = iterations};
+    const long before = hnn::testing::allocation_count();
+    const SampledFitReport report = fit_sampled(*model, train.x, train.dxdt, fit);
+    EXPECT_EQ(report.iterations, iterations);
+    return hnn::testing::allocation_count() - before;
+  };
+  allocations(5);  // warms up the engine's and OpenBLAS's threads
+  EXPECT_EQ(allocations(25), allocations(5));
 }
 
 }  // namespace
