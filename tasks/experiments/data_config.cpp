@@ -9,6 +9,7 @@
 #include "nn/enum_names.h"
 #include "tasks/error.h"
 #include "tasks/field/rollout_settings.h"
+#include "tasks/train/fit_method.h"
 
 namespace hnn::tasks {
 
@@ -38,7 +39,12 @@ const std::vector<std::string>& data_setting_names() {
       "split",           "test_fraction", "gap_factor", "hamiltonian", "standardize", "threshold",
       "rollouts",        "t_end",         "loss",       "horizon",     "integrator",  "dt",
       "energy_rollouts", "energy_t_end"};
-  return names;
+  static const std::vector<std::string> with_fit = [] {
+    std::vector<std::string> all = names;
+    all.insert(all.end(), fit_setting_names().begin(), fit_setting_names().end());
+    return all;
+  }();
+  return with_fit;
 }
 
 DataConfig data_config(const json& s) {

@@ -241,6 +241,7 @@ std::optional<SplitStretches> FieldTask::stretches(const RunSettings&, const Dat
 void FieldTask::check_task_settings(const nlohmann::json& settings) const {
   const std::vector<std::string> own = own_setting_names(), rollouts = evaluation_setting_names();
   std::vector<std::string> known = rollout_setting_names();
+  known.insert(known.end(), fit_setting_names().begin(), fit_setting_names().end());
   known.insert(known.end(), own.begin(), own.end());
   known.insert(known.end(), rollouts.begin(), rollouts.end());
   for (const auto& [key, value] : settings.items()) {

@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <optional>
 #include <utility>
@@ -38,11 +39,33 @@ std::string text_at(const json& m, const std::string& key) {
   return it->is_string() ? it->get<std::string>() : it->dump();
 }
 
+// "2000 steps"; "sampled fit (uswim)" or "sampled fit (uswim), then 200 Adam steps".
+std::string fit_words(const json& m) {
+  const std::string steps = fmt::format("{} steps", text_at(m, "steps"));
+  const auto fit = m.find("fit");
+  if (fit == m.end() || !fit->is_object()) return steps;
+  const std::string sampled = fmt::format("sampled fit ({})", text_at(*fit, "sampler"));
+  return text_at(*fit, "method") == "sampled" ? sampled : sampled + ", then Adam " + steps;
+}
+
 // "spring hnn: seed 0, 2000 steps, hidden 200-200, double".
 std::string heading_line(const json& m) {
-  return fmt::format("{} {}: seed {}, {} steps, hidden {}, {}", text_at(m, "task"),
-                     text_at(m, "model"), text_at(m, "seed"), text_at(m, "steps"),
-                     text_at(m, "hidden"), text_at(m, "dtype"));
+  return fmt::format("{} {}: seed {}, {}, hidden {}, {}", text_at(m, "task"), text_at(m, "model"),
+                     text_at(m, "seed"), fit_words(m), text_at(m, "hidden"), text_at(m, "dtype"));
+}
+
+// "  fit        sampling 0.01 s, forming the matrix 0.02 s, solving 0.1 s (qr): 2000 x 100
+// system, 1.6 MB, residual 1.2e-05".
+std::string fit_line(const json& m) {
+  const auto fit = m.find("fit");
+  if (fit == m.end() || !fit->is_object()) return "";
+  const auto seconds = [&](const char* key) { return number_at(*fit, key).value_or(NAN); };
+  return fmt::format(
+      "  fit        sampling {:.3g} s, forming the matrix {:.3g} s, solving {:.3g} s ({}): {} x {} "
+      "system, {:.3g} MB, residual {:.3g}\n",
+      seconds("sample_seconds"), seconds("assemble_seconds"), seconds("solve_seconds"),
+      text_at(*fit, "solver"), text_at(*fit, "rows"), text_at(*fit, "columns"),
+      seconds("matrix_bytes") / 1e6, seconds("residual_rms"));
 }
 
 // "  loss     test 3.1e-02 ± 1e-03, train 3e-02 ± 1e-03; R² test 0.998, train 0.999".
@@ -126,7 +149,7 @@ std::string timing_line(const json& m) {
 
 std::string metrics_summary(const json& m) {
   return heading_line(m) + "\n" + loss_lines(m) + prediction_line(m) + skipped_rollouts_line(m) +
-         hamiltonian_line(m) + energy_lines(m) + timing_line(m);
+         hamiltonian_line(m) + energy_lines(m) + fit_line(m) + timing_line(m);
 }
 
 void print_warnings(const json& metrics) {
