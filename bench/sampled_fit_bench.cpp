@@ -118,7 +118,7 @@ int main(int argc, char** argv) try {
   fit.sampler =
       nn::parse_name(nn::kHiddenSamplerNames, arg(argc, argv, "sampler", "uswim"), "sampler");
   fit.solver =
-      nn::parse_name(nn::kLeastSquaresSolverNames, arg(argc, argv, "solver", "lsqr"), "solver");
+      nn::parse_name(nn::kLeastSquaresSolverNames, arg(argc, argv, "solver", "qr"), "solver");
   fit.regularization =
       std::stod(arg(argc, argv, "regularization", fmt::format("{}", fit.regularization)));
   fit.rcond = std::stod(arg(argc, argv, "rcond", fmt::format("{}", fit.rcond)));

@@ -36,6 +36,19 @@ struct Preconditioner {
   }
 };
 
+// A column of A that is zero (a neuron whose input gradient vanishes at every data point)
+// leaves its unknown without an equation: the system is singular, whatever the solver.
+void check_columns(const Eigen::VectorXd& squared_norms) {
+  for (Index j = 0; j < squared_norms.size(); ++j) {
+    if (!(squared_norms(j) > 0)) {
+      throw std::invalid_argument(fmt::format(
+          "sampled fit: the last layer's system is singular: unknown {} has no equation (its "
+          "neuron's input gradient is zero at every data point)",
+          j));
+    }
+  }
+}
+
 // The normal equations' factor: columns scaled to unit norm (s = diag(A^T A)^-1/2: SWIM's
 // neurons differ in slope by orders of magnitude), then R^T R = S A^T A S + lambda I, lambda
 // raised tenfold while the factorisation fails (the scaled Gram's rounding is about 1e-16, so
@@ -44,14 +57,7 @@ constexpr double kLargestRegularization = 1e-6;
 
 Preconditioner cholesky_preconditioner(const ColMat& gram, double regularization, double& used) {
   const Index p = gram.rows();
-  for (Index j = 0; j < p; ++j) {
-    if (!(gram(j, j) > 0)) {
-      throw std::invalid_argument(fmt::format(
-          "sampled fit: the last layer's system is singular: unknown {} (neuron {}) has no "
-          "equation (its input gradient is zero at every data point)",
-          j, j));
-    }
-  }
+  check_columns(gram.diagonal());
   Preconditioner m{ColMat(p, p), {}};
   m.s = gram.diagonal().cwiseMax(std::numeric_limits<double>::min()).cwiseSqrt().cwiseInverse();
   for (used = regularization; used <= kLargestRegularization; used *= 10) {
@@ -153,6 +159,7 @@ void solve_by_svd(const LinearSystem& system, double rcond, LeastSquaresResult& 
   system.reduced(a, b);
   out.gram_seconds = seconds_since(start);
   out.bytes = std::size_t(a.size() + b.size()) * sizeof(double);
+  check_columns(a.colwise().squaredNorm().transpose());  // the reduction keeps column norms
   start = Clock::now();
   lstsq_svd(a, b, rcond);
   out.c = b.topRows(system.unknowns());

@@ -32,7 +32,8 @@ enum class LeastSquaresSolver {
   kLsqr,      // LSQR on A, right-preconditioned by the Cholesky factor of the regularised Gram,
               // started from the normal equations' solution
   kCholesky,  // the regularised normal equations (A^T A + lambda I) c = A^T b, by Cholesky
-  kQr,        // LAPACK's dgelsd (SVD-based, like np.linalg.lstsq) on the formed A: the reference
+  kQr,        // LAPACK's dgelsd (SVD-based, like np.linalg.lstsq) on A, or for one hidden layer
+              // on its reduction by a QR of D (docs/sampled.md)
 };
 inline constexpr NameTable<LeastSquaresSolver, 3> kLeastSquaresSolverNames{{
     {LeastSquaresSolver::kLsqr, "lsqr"},
@@ -47,7 +48,8 @@ struct SampledFitConfig {
   /// np.linalg.lstsq rcond); each solver honours it in its own way (docs/sampled.md).
   double rcond = 1e-13;
   std::uint64_t seed = 0;
-  LeastSquaresSolver solver = LeastSquaresSolver::kLsqr;
+  /// kQr by default: the only solver that keeps the peer's accuracy (docs/sampled.md).
+  LeastSquaresSolver solver = LeastSquaresSolver::kQr;
   /// lambda, added to the diagonal of A^T A after its columns are scaled to unit norm, for
   /// kCholesky and kLsqr's preconditioner. When the Cholesky factorisation fails, lambda is
   /// raised tenfold until it succeeds (at most to 1e-6; beyond, the system is called singular).

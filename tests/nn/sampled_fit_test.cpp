@@ -187,14 +187,17 @@ TEST(SampledFit, SingularSystemIsRefused) {
   relu.activation = Activation::kRelu;
   std::mt19937_64 rng(1);
   auto model = make_model<double>(relu, rng);
-  SampledFitConfig fit;
-  fit.sampler = HiddenSampler::kElm;
-  try {
-    fit_sampled(*model, same.x, same.dxdt, fit);
-    ADD_FAILURE() << "a singular system was solved";
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("singular"), std::string::npos) << e.what();
+  const Matrix<double> before = model->mlp().layers()[1].weight().value();
+  for (LeastSquaresSolver solver :
+       {LeastSquaresSolver::kQr, LeastSquaresSolver::kLsqr, LeastSquaresSolver::kCholesky}) {
+    try {
+      fit_sampled(*model, same.x, same.dxdt, {.sampler = HiddenSampler::kElm, .solver = solver});
+      ADD_FAILURE() << "a singular system was solved";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("singular"), std::string::npos) << e.what();
+    }
   }
+  EXPECT_EQ(model->mlp().layers()[1].weight().value(), before);  // nothing written
 }
 
 // The fit allocates its matrices once: LSQR's iterations allocate nothing, so a fit of 25
@@ -205,7 +208,8 @@ TEST(SampledFit, LsqrIterationsAllocateNothing) {
   auto allocations = [&](int iterations) {
     std::mt19937_64 rng(1);
     auto model = make_model<double>(model_config(ModelKind::kHnn, {60}), rng);
-    const SampledFitConfig fit{.tolerance = 0, .max_iterations = iterations};
+    const SampledFitConfig fit{
+        .solver = LeastSquaresSolver::kLsqr, .tolerance = 0, .max_iterations = iterations};
     const long before = hnn::testing::allocation_count();
     const SampledFitReport report = fit_sampled(*model, train.x, train.dxdt, fit);
     EXPECT_EQ(report.iterations, iterations);
