@@ -1,0 +1,67 @@
+"""hnn from Python: Hamiltonian neural networks and their kin on hnn's C++ library.
+
+States are NumPy arrays [batch, 2n], q then p (an LNN's: q then dq/dt); derivatives have the
+same shape. Models compute in float64 unless made with dtype="float32". See docs/python.md.
+"""
+
+from . import _hnn
+from ._hnn import Error, Model, set_threads, threads
+from . import systems
+from .runs import Run, load_run, train
+
+__all__ = ["HNN", "DHNN", "Baseline", "LNN", "Model", "Error", "load", "train", "load_run",
+           "Run", "systems", "set_threads", "threads"]
+
+
+def _make(kind, dim, hidden, activation, dtype, seed, angles=0, kinetic_prior=1.0):
+    return Model(kind, int(dim), [int(w) for w in hidden], activation, dtype, int(seed),
+                 int(angles), float(kinetic_prior))
+
+
+def HNN(dim, hidden=(200, 200), activation="tanh", *, dtype="float64", seed=0, angles=0):
+    """A Hamiltonian neural network: an MLP learns H(q, p); dx/dt = (dH/dp, -dH/dq).
+
+    dim is the state's size 2n; the first `angles` coordinates are seen as (cos, sin).
+    Weights are initialised from `seed` as the hnn program does (orthogonal)."""
+    return _make("hnn", dim, hidden, activation, dtype, seed, angles)
+
+
+def DHNN(dim, hidden=(200, 200), activation="tanh", *, dtype="float64", seed=0, angles=0):
+    """The dissipative HNN (Sosanya & Greydanus 2022): H and a dissipation potential D."""
+    return _make("dhnn", dim, hidden, activation, dtype, seed, angles)
+
+
+def Baseline(dim, hidden=(200, 200), activation="tanh", *, dtype="float64", seed=0, angles=0):
+    """The baseline: an MLP that outputs dx/dt directly."""
+    return _make("baseline", dim, hidden, activation, dtype, seed, angles)
+
+
+def LNN(dim, hidden=(200, 200), activation="tanh", *, dtype="float64", seed=0, angles=0,
+        kinetic_prior=1.0):
+    """The Lagrangian NN (Cranmer et al. 2020): L(q, v) learned, states x = (q, v = dq/dt)."""
+    return _make("lnn", dim, hidden, activation, dtype, seed, angles, kinetic_prior)
+
+
+def load(path, *, angles=0, kinetic_prior=1.0):
+    """A model from a parameter file (Model.save's, or a run's params.bin), or a run folder's.
+
+    A parameter file records the model's kind, activation and widths; `angles` and
+    `kinetic_prior` it does not: give them when the model was made with others. A run folder
+    gives its model in the data's units, in float64, as `hnn export` does."""
+    return Model.load(str(path), angles=int(angles), kinetic_prior=float(kinetic_prior))
+
+
+def _fit(self, x, dxdt, steps=1000, lr=1e-3, batch=0, seed=0, record_every=1, weight_decay=0.0):
+    """Trains on states x and their derivatives dxdt ([rows, dim] each) with Adam.
+
+    The hnn program's loop and loss (the mean squared error of the field): `batch` rows drawn
+    with replacement each step from `seed` (0: every row, every step). Returns the loss history:
+    the loss over every row at every `record_every`-th step and the last. Ctrl-C stops after
+    the current step, raising KeyboardInterrupt with the model at that step."""
+    spec = _hnn._FitSpec()
+    spec.steps, spec.lr, spec.batch, spec.seed = int(steps), float(lr), int(batch), int(seed)
+    spec.record_every, spec.weight_decay = int(record_every), float(weight_decay)
+    return self._fit(x, dxdt, spec)
+
+
+Model.fit = _fit
