@@ -12,7 +12,7 @@ namespace {
 
 std::string shape_text(const py::array& a) {
   std::vector<py::ssize_t> shape(a.shape(), a.shape() + a.ndim());
-  return fmt::format("({})", fmt::join(shape, ", "));
+  return fmt::format("({}{})", fmt::join(shape, ", "), shape.size() == 1 ? "," : "");  // NumPy's
 }
 
 // `obj` as an array of numbers (bool, strings and objects refused), not yet converted.

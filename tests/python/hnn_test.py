@@ -1,0 +1,261 @@
+"""The Python package hnn (apps/python/) on small models, against the hnn program ($HNN_EXE).
+
+Run by ctest with PYTHONPATH at the built package (tests/CMakeLists.txt): python.Models,
+python.Errors, python.Systems, python.Programs."""
+
+import csv
+import json
+import os
+import subprocess
+import tempfile
+import unittest
+
+import numpy as np
+
+import hnn
+
+HNN_EXE = os.environ.get("HNN_EXE", "hnn")
+
+
+def spring_data(n=64, seed=1):
+    spring = hnn.systems.Spring()
+    x = spring.initial_states(n, seed=seed)
+    return x, spring.vector_field(x)
+
+
+def run_hnn(*args, cwd):
+    result = subprocess.run([HNN_EXE, *args], cwd=cwd, capture_output=True, text=True)
+    if result.returncode != 0:
+        raise AssertionError(f"hnn {' '.join(args)}: {result.stderr}")
+    return result.stdout
+
+
+class Models(unittest.TestCase):
+    def test_fit_lowers_the_loss(self):
+        x, dxdt = spring_data()
+        for make in (hnn.HNN, hnn.Baseline, hnn.DHNN):
+            model = make(2, hidden=(16, 16), seed=3)
+            losses = model.fit(x, dxdt, steps=60, lr=1e-2)
+            self.assertEqual(losses.shape, (60,))
+            self.assertLess(losses[-1], 0.2 * losses[0], make.__name__)
+
+    def test_fit_is_seeded_and_batched(self):
+        x, dxdt = spring_data()
+        runs = [hnn.HNN(2, hidden=(8,), seed=0).fit(x, dxdt, steps=10, batch=16, seed=s,
+                                                     record_every=5) for s in (0, 0, 1)]
+        self.assertEqual(runs[0].shape, (2,))
+        np.testing.assert_array_equal(runs[0], runs[1])
+        self.assertFalse(np.array_equal(runs[0], runs[2]))
+
+    def test_float32_models_compute_in_float32(self):
+        x, dxdt = spring_data()
+        model = hnn.HNN(2, hidden=(8, 8), dtype="float32")
+        self.assertEqual(model.dtype, "float32")
+        self.assertEqual(model.vector_field(x).dtype, np.float32)
+        self.assertEqual(model.parameters()["mlp.layers.0.weight"].dtype, np.float32)
+        losses = model.fit(x, dxdt, steps=20, lr=1e-2)
+        self.assertLess(losses[-1], losses[0])
+
+    def test_hnn_field_is_the_symplectic_gradient_of_its_h(self):
+        model = hnn.HNN(2, hidden=(8, 8), seed=2)
+        x = np.array([[0.3, -0.2], [1.0, 0.5]])
+        eps = 1e-6
+        dh = [(model.hamiltonian(x + eps * e) - model.hamiltonian(x - eps * e)) / (2 * eps)
+              for e in np.eye(2)]
+        np.testing.assert_allclose(model.vector_field(x), np.stack([dh[1], -dh[0]], axis=1),
+                                   rtol=1e-6, atol=1e-8)
+
+    def test_save_load_round_trip(self):
+        model = hnn.DHNN(2, hidden=(8, 8), seed=5)
+        x, _ = spring_data(8)
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "params.bin")
+            model.save(path)
+            loaded = hnn.load(path)
+        self.assertEqual((loaded.kind, loaded.dim, loaded.dtype),
+                         ("hnn-dissipative", 2, "float64"))
+        for name, value in model.parameters().items():
+            np.testing.assert_array_equal(loaded.parameters()[name], value)
+        np.testing.assert_array_equal(loaded.vector_field(x), model.vector_field(x))
+
+    def test_set_parameters_all_or_none(self):
+        a, b = hnn.HNN(2, hidden=(4,), seed=0), hnn.HNN(2, hidden=(4,), seed=1)
+        x, _ = spring_data(4)
+        b.set_parameters(a.parameters())
+        np.testing.assert_array_equal(a.vector_field(x), b.vector_field(x))
+        bad = a.parameters()
+        bad["mlp.layers.1.weight"] = np.zeros((3, 1))
+        before = b.parameters()["mlp.layers.0.weight"].copy()
+        with self.assertRaisesRegex(hnn.Error, "mlp.layers.1.weight"):
+            b.set_parameters({**bad, "mlp.layers.0.weight": np.ones((2, 4))})
+        np.testing.assert_array_equal(b.parameters()["mlp.layers.0.weight"], before)
+
+    def test_rollout_of_a_fitted_field_follows_the_system(self):
+        x, dxdt = spring_data(128)
+        model = hnn.HNN(2, hidden=(32, 32), seed=0)
+        model.fit(x, dxdt, steps=300, lr=1e-2)
+        t = np.linspace(0, 1, 11)
+        x0 = np.array([[0.5, 0.0]])
+        pred = model.rollout(x0, t, integrator="rk4", dt=0.01)
+        true = hnn.systems.Spring().simulate(x0, t)
+        self.assertEqual(pred.shape, (11, 1, 2))
+        self.assertLess(np.abs(pred - true).max(), 0.05)
+
+    def test_other_layouts_and_dtypes_give_the_same_results(self):
+        model = hnn.HNN(2, hidden=(8,), seed=0)
+        x = np.array([[0.1, 0.2], [0.3, -0.4], [0.5, 0.6]])
+        want = model.vector_field(x)
+        np.testing.assert_array_equal(model.vector_field(np.asfortranarray(x)), want)
+        np.testing.assert_array_equal(model.vector_field(np.hstack([x, x])[:, :2]), want)
+        ints = np.array([[1, 2], [0, -1]])
+        np.testing.assert_array_equal(model.vector_field(ints),
+                                      model.vector_field(ints.astype(float)))
+
+
+class Errors(unittest.TestCase):
+    def setUp(self):
+        self.model = hnn.HNN(2, hidden=(4,))
+
+    def expect(self, pattern, call, *args, **kwargs):
+        with self.assertRaisesRegex(hnn.Error, pattern) as caught:
+            call(*args, **kwargs)
+        self.assertNotIn("\n", str(caught.exception))
+        self.assertIsInstance(caught.exception, ValueError)
+
+    def test_bad_states(self):
+        f = self.model.vector_field
+        self.expect(r"x: expected 2 columns \(q then p\), got shape \(3, 3\)", f, np.zeros((3, 3)))
+        self.expect(r"x: expected a 2-D array \[batch, 2\], got shape \(2,\)", f, np.zeros(2))
+        self.expect("x: expected an array of numbers, got dtype <U1", f, [["a", "b"]])
+        self.expect("x: expected an array of numbers, got dtype object", f,
+                    np.array([[None, 1]], dtype=object))
+        self.expect(r"x: the array is empty \(no rows\)", f, np.zeros((0, 2)))
+        self.expect("x: NaN or infinity at row 1, column 0", f, [[0, 0], [np.nan, 0]])
+        self.expect("x: NaN or infinity", f, [[np.inf, 0]])
+
+    def test_bad_model_calls(self):
+        x, dxdt = spring_data(8)
+        self.expect("dxdt: expected 8 rows", self.model.fit, x, dxdt[:4], steps=1)
+        self.expect("batch must be 0", self.model.fit, x, dxdt, steps=1, batch=9)
+        self.expect("a baseline model learns no H", hnn.Baseline(2, hidden=(4,)).hamiltonian, x)
+        self.expect("dtype must be float32 or float64", hnn.HNN, 2, dtype="half")
+        self.expect("activation", hnn.HNN, 2, activation="cube")
+        self.expect("t: expected a 1-D array of times", self.model.rollout, x, [[0, 1]])
+        self.expect("integrator", self.model.rollout, x, [0, 1], integrator="magic")
+        self.expect("unknown parameter 'w'", self.model.set_parameters, {"w": np.zeros((1, 1))})
+
+    def test_bad_files(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "params.bin")
+            with open(path, "w") as f:
+                f.write("not a parameter file")
+            self.expect("parameter file", hnn.load, path)
+            self.expect("parameter file", hnn.load, os.path.join(tmp, "missing.bin"))
+            self.expect("not a run folder", hnn.load_run, tmp)
+
+    def test_train_options(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            out = os.path.join(tmp, "run")
+            self.expect(r"unknown option 'stepz' of hnn train \(options: model, steps",
+                        hnn.train, "spring", out=out, stepz=3)
+            self.expect("steps: expected an integer >= 1, got 0", hnn.train, "spring", out=out,
+                        steps=0)
+            self.expect("unknown model 'hnnn'", hnn.train, "spring", model="hnnn", out=out)
+            self.expect("coords applies to the data task only", hnn.train, "spring", out=out,
+                        coords=["q"])
+            self.expect("json: not taken from Python", hnn.train, "spring", out=out, json=True)
+            self.assertFalse(os.path.exists(out))
+
+
+class Systems(unittest.TestCase):
+    def test_simulate_conserves_h(self):
+        cases = [(hnn.systems.Spring(), [[0.5, 0.2]]), (hnn.systems.Pendulum(), [[1.0, 0.0]]),
+                 (hnn.systems.DoublePendulum(), [[0.3, -0.2, 0.1, 0.0]]),
+                 (hnn.systems.NBody(2), hnn.systems.NBody(2).initial_states(1, seed=0)),
+                 (hnn.systems.Expression("p^2/2 + 9.81*(1 - cos(q))", coords=["q"],
+                                         momenta=["p"]), [[1.0, 0.5]])]
+        t = np.linspace(0, 2, 21)
+        for system, x0 in cases:
+            path = system.simulate(np.array(x0, dtype=float), t, rtol=1e-10)
+            self.assertEqual(path.shape, (21, 1, system.dim))
+            h = np.array([system.hamiltonian(state)[0] for state in path])
+            self.assertLess(np.abs(h - h[0]).max(), 1e-7 * max(1.0, abs(h[0])), system.name)
+
+    def test_expression_matches_the_library_pendulum(self):
+        expr = hnn.systems.Expression("3*(1 - cos(q)) + p^2", coords=["q"], momenta=["p"])
+        x = hnn.systems.Pendulum().initial_states(5, seed=2)
+        np.testing.assert_allclose(expr.vector_field(x), hnn.systems.Pendulum().vector_field(x),
+                                   rtol=1e-12, atol=1e-12)
+        np.testing.assert_allclose(expr.hamiltonian(x), hnn.systems.Pendulum().hamiltonian(x),
+                                   rtol=1e-12)
+
+    def test_symplectic_integrators(self):
+        spring = hnn.systems.Spring()
+        x0 = np.array([[1.0, 0.0]])
+        path = spring.simulate(x0, np.linspace(0, 50, 6), integrator="leapfrog", dt=0.05)
+        h = spring.hamiltonian(path[:, 0, :])
+        self.assertLess(np.abs(h - 1).max(), 5e-3)  # bounded, not drifting
+        with self.assertRaisesRegex(hnn.Error, "x0: expected 2 columns"):
+            spring.simulate(np.zeros((1, 3)), [0, 1])
+        with self.assertRaisesRegex(hnn.Error, "leapfrog needs a separable Hamiltonian"):
+            hnn.systems.DoublePendulum().simulate(np.zeros((1, 4)), [0, 1], integrator="leapfrog")
+
+
+class Programs(unittest.TestCase):
+    """The package against the hnn program: the same files, the same runs."""
+
+    @classmethod
+    def setUpClass(cls):
+        cls.tmp = tempfile.TemporaryDirectory()
+        cls.dir = cls.tmp.name
+        cls.options = ["--steps", "20", "--hidden", "8", "8", "--lr", "0.01", "--quiet"]
+        run_hnn("train", "spring", "--out", "cli", *cls.options, cwd=cls.dir)
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.tmp.cleanup()
+
+    def test_train_gives_the_programs_metrics(self):
+        run = hnn.train("spring", out=os.path.join(self.dir, "py"), steps=20, hidden=[8, 8],
+                        lr=0.01, quiet=True)
+        cli = hnn.load_run(os.path.join(self.dir, "cli"))
+        timing = {k for k in cli.metrics if k.endswith("seconds")}
+        self.assertTrue(timing)
+        same = {k: v for k, v in cli.metrics.items() if k not in timing}
+        self.assertEqual({k: v for k, v in run.metrics.items() if k not in timing}, same)
+        curve = run.loss_curve
+        self.assertEqual(list(curve), ["step", "train_loss", "test_loss"])
+        np.testing.assert_array_equal(curve["train_loss"], cli.loss_curve["train_loss"])
+        self.assertEqual(run.rollouts["hnn"]["x"].shape[2], 2)
+        np.testing.assert_array_equal(run.rollouts["true"]["x"], cli.rollouts["true"]["x"])
+
+    def test_a_model_saved_from_python_runs_in_the_program(self):
+        # The run's own model, its weights changed from Python and saved into a copy of the run:
+        # the program's rollout of it is the package's.
+        run_dir = os.path.join(self.dir, "changed")
+        run_hnn("train", "spring", "--out", run_dir, *self.options, cwd=self.dir)
+        model = hnn.load_run(run_dir).model
+        changed = {k: v * 1.1 for k, v in model.parameters().items()}
+        model.set_parameters(changed)
+        model.save(os.path.join(run_dir, "params.bin"))
+        run_hnn("rollout", run_dir, "--state", "0.5,0.1", "--integrator", "rk4", "--dt", "0.01",
+                "--t-end", "0.5", "--points", "6", "--out", "r.csv", cwd=self.dir)
+        with open(os.path.join(self.dir, "r.csv"), newline="") as f:
+            rows = [r for r in csv.DictReader(f) if r["source"] == "hnn"]
+        program = np.array([[float(r["x_0"]), float(r["x_1"])] for r in rows])
+        ours = hnn.load(os.path.join(run_dir, "params.bin")).rollout(
+            [[0.5, 0.1]], np.linspace(0, 0.5, 6), integrator="rk4", dt=0.01)[:, 0, :]
+        np.testing.assert_allclose(ours, program, rtol=1e-10, atol=1e-12)
+
+    def test_load_reads_the_programs_params(self):
+        params = os.path.join(self.dir, "cli", "params.bin")
+        model = hnn.load(params)
+        self.assertEqual((model.kind, model.dim), ("hnn", 2))
+        x, _ = spring_data(5)
+        np.testing.assert_array_equal(model.vector_field(x),
+                                      hnn.load_run(os.path.join(self.dir, "cli")).model
+                                      .vector_field(x))
+
+
+if __name__ == "__main__":
+    unittest.main()
