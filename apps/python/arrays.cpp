@@ -34,8 +34,8 @@ template <typename T>
 void check_finite(const T* data, Eigen::Index rows, Eigen::Index cols, std::string_view what) {
   for (Eigen::Index i = 0; i < rows * cols; ++i) {
     if (!std::isfinite(data[i])) {
-      throw InputError(fmt::format("{}: NaN or infinity at row {}, column {}", what, i / cols,
-                                   i % cols));
+      throw InputError(
+          fmt::format("{}: NaN or infinity at row {}, column {}", what, i / cols, i % cols));
     }
   }
 }
@@ -50,8 +50,8 @@ Matrix<T> states(const py::handle& obj, std::string_view what, Eigen::Index cols
                                  shape_text(a)));
   }
   if (a.shape(1) != cols) {
-    throw InputError(fmt::format("{}: expected {} columns (q then p), got shape {}", what, cols,
-                                 shape_text(a)));
+    throw InputError(
+        fmt::format("{}: expected {} columns (q then p), got shape {}", what, cols, shape_text(a)));
   }
   if (a.shape(0) == 0) throw InputError(fmt::format("{}: the array is empty (no rows)", what));
   // Converted once to C order and T (a contiguous array of T is used as it is).
@@ -63,8 +63,8 @@ Matrix<T> states(const py::handle& obj, std::string_view what, Eigen::Index cols
 std::vector<double> times(const py::handle& obj, std::string_view what) {
   const py::array a = numeric(obj, what);
   if (a.ndim() != 1)
-    throw InputError(fmt::format("{}: expected a 1-D array of times, got shape {}", what,
-                                 shape_text(a)));
+    throw InputError(
+        fmt::format("{}: expected a 1-D array of times, got shape {}", what, shape_text(a)));
   if (a.shape(0) == 0) throw InputError(fmt::format("{}: the array is empty (no times)", what));
   const auto c = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(a);
   check_finite(c.data(), a.shape(0), 1, what);

@@ -33,6 +33,7 @@ struct FitSpec {
   std::uint64_t seed = 0;
   long record_every = 1;
   double weight_decay = 0;
+  py::object callback = py::none();  // called with (step, loss) at each loss-history point
 };
 
 class Model {
@@ -68,7 +69,8 @@ class Model {
     return std::visit([&](const auto& m) -> decltype(auto) { return f(*m); }, model_);
   }
 
-  std::variant<std::unique_ptr<nn::DynamicsModel<float>>, std::unique_ptr<nn::DynamicsModel<double>>>
+  std::variant<std::unique_ptr<nn::DynamicsModel<float>>,
+               std::unique_ptr<nn::DynamicsModel<double>>>
       model_;
 };
 

@@ -16,16 +16,35 @@ namespace hnn::python {
 
 namespace {
 
+// The field objective, keeping its last loss-curve point for fit's callback.
+template <typename T>
+class ReportingObjective : public tasks::FieldObjective<T> {
+ public:
+  using tasks::FieldObjective<T>::FieldObjective;
+  tasks::CurvePoint curve_point(long step, double batch_loss) const override {
+    last = tasks::FieldObjective<T>::curve_point(step, batch_loss);
+    return last;
+  }
+  mutable tasks::CurvePoint last{};
+};
+
 template <typename T>
 tasks::TrainResult fit_model(nn::DynamicsModel<T>& model, const tasks::Dataset& data,
                              const FitSpec& spec, tasks::StopSignal* stop) {
-  tasks::FieldObjective<T> objective(
-      model, data, spec.batch, {.lr = spec.lr, .weight_decay = spec.weight_decay}, spec.seed);
-  return tasks::train(objective, {.steps = spec.steps,
-                                  .record_every = spec.record_every,
-                                  .quiet = true,
-                                  .label = "fit",
-                                  .stop = stop});
+  ReportingObjective<T> objective(model, data, spec.batch,
+                                  {.lr = spec.lr, .weight_decay = spec.weight_decay}, spec.seed);
+  tasks::LoopOptions loop{.steps = spec.steps,
+                          .record_every = spec.record_every,
+                          .quiet = true,
+                          .label = "fit",
+                          .stop = stop};
+  if (!spec.callback.is_none()) {
+    loop.on_record = [&](long step) {
+      py::gil_scoped_acquire hold;  // a Python exception it raises ends the fit
+      spec.callback(step, objective.last.train_loss);
+    };
+  }
+  return tasks::train(objective, loop);
 }
 
 }  // namespace
@@ -68,16 +87,19 @@ void bind_model(py::module_& m) {
       .def_readwrite("batch", &FitSpec::batch)
       .def_readwrite("seed", &FitSpec::seed)
       .def_readwrite("record_every", &FitSpec::record_every)
-      .def_readwrite("weight_decay", &FitSpec::weight_decay);
-  py::class_<Model>(m, "Model", "A learned dynamics model: hnn.HNN, hnn.DHNN, hnn.Baseline, hnn.LNN.")
+      .def_readwrite("weight_decay", &FitSpec::weight_decay)
+      .def_readwrite("callback", &FitSpec::callback);
+  py::class_<Model>(m, "Model",
+                    "A learned dynamics model: hnn.HNN, hnn.DHNN, hnn.Baseline, hnn.LNN.")
       .def(py::init([](const std::string& kind, long dim, std::vector<long> hidden,
-                       const std::string& activation, const std::string& dtype,
-                       std::uint64_t seed, long angles, double kinetic_prior) {
+                       const std::string& activation, const std::string& dtype, std::uint64_t seed,
+                       long angles, double kinetic_prior) {
              if (dtype != "float32" && dtype != "float64")
                throw InputError(fmt::format("dtype must be float32 or float64, got '{}'", dtype));
              ModelSpec spec{.float32 = dtype == "float32", .seed = seed};
              spec.config.model = nn::parse_model_kind(kind);
-             if (spec.config.model == nn::ModelKind::kDhnn) spec.config.field = nn::FieldType::kBoth;
+             if (spec.config.model == nn::ModelKind::kDhnn)
+               spec.config.field = nn::FieldType::kBoth;
              spec.config.dim = dim;
              spec.config.hidden.assign(hidden.begin(), hidden.end());
              spec.config.activation = nn::parse_activation(activation);

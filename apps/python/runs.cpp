@@ -35,8 +35,7 @@ std::string refused(const TrainOption& option) {
 std::string option_names() {
   std::vector<std::string> names;
   for (const TrainOption& option : tasks::train_options())
-    if (option.kind != ValueKind::kTask && refused(option).empty())
-      names.emplace_back(option.name);
+    if (option.kind != ValueKind::kTask && refused(option).empty()) names.emplace_back(option.name);
   return fmt::format("{}", fmt::join(names, ", "));
 }
 
@@ -46,12 +45,12 @@ json canonical(const TrainOption& option, const json& value) {
   switch (option.kind) {
     case ValueKind::kFlag:
       if (value.is_boolean()) return value;
-      throw InputError(fmt::format("{}: expected True or False, got {}", option.name,
-                                   value.dump()));
+      throw InputError(
+          fmt::format("{}: expected True or False, got {}", option.name, value.dump()));
     case ValueKind::kFolder:
       if (value.is_string() && !value.get<std::string>().empty()) return value;
-      throw InputError(fmt::format("{}: expected a folder's name, got {}", option.name,
-                                   value.dump()));
+      throw InputError(
+          fmt::format("{}: expected a folder's name, got {}", option.name, value.dump()));
     default:
       try {
         return app::sweep::checked_value(option, value);
@@ -70,8 +69,8 @@ tasks::RunOptions run_options(const std::string& task, const json& given) {
     std::replace(name.begin(), name.end(), '_', '-');
     const TrainOption* option = tasks::find_train_option(name);
     if (option == nullptr || option->kind == ValueKind::kTask)
-      throw InputError(fmt::format("unknown option '{}' of hnn train (options: {})", key,
-                                   option_names()));
+      throw InputError(
+          fmt::format("unknown option '{}' of hnn train (options: {})", key, option_names()));
     if (const std::string why = refused(*option); !why.empty())
       throw InputError(fmt::format("{}: not taken from Python: {}", key, why));
     if (!value.is_null()) asked.emplace_back(option, value);

@@ -64,7 +64,8 @@ void bind_systems(py::module_& m) {
   py::class_<System, SystemPtr>(s, "System", "A Hamiltonian system in x = (q, p)")
       .def_property_readonly("dim", &System::dim)
       .def_property_readonly("name", &System::name)
-      .def("__repr__", [](const System& self) { return "<hnn.systems.System " + self.name() + ">"; })
+      .def("__repr__",
+           [](const System& self) { return "<hnn.systems.System " + self.name() + ">"; })
       .def("hamiltonian", &system_hamiltonian, py::arg("x"), "H at each state of x, [batch]")
       .def("vector_field", &system_field, py::arg("x"),
            "The exact dx/dt = (dH/dp, -dH/dq) at each state of x, [batch, dim]")
@@ -86,8 +87,8 @@ void bind_systems(py::module_& m) {
     return std::make_shared<physics::DoublePendulum>(m1, m2, l1, l2, g);
   });
   s.def("expression",
-        [](std::string h, std::vector<std::string> coords, std::vector<std::string> momenta)
-            -> SystemPtr {
+        [](std::string h, std::vector<std::string> coords,
+           std::vector<std::string> momenta) -> SystemPtr {
           return std::make_shared<physics::ExpressionSystem>(std::move(h), std::move(coords),
                                                              std::move(momenta));
         });

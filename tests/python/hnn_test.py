@@ -6,8 +6,10 @@ python.Errors, python.Systems, python.Programs."""
 import csv
 import json
 import os
+import signal
 import subprocess
 import tempfile
+import threading
 import unittest
 
 import numpy as np
@@ -46,6 +48,34 @@ class Models(unittest.TestCase):
         self.assertEqual(runs[0].shape, (2,))
         np.testing.assert_array_equal(runs[0], runs[1])
         self.assertFalse(np.array_equal(runs[0], runs[2]))
+
+    def test_fit_reports_progress(self):
+        x, dxdt = spring_data()
+        seen = []
+        losses = hnn.HNN(2, hidden=(8,)).fit(x, dxdt, steps=9, record_every=4,
+                                              callback=lambda step, loss: seen.append((step, loss)))
+        self.assertEqual([s for s, _ in seen], [4, 8, 9])
+        np.testing.assert_array_equal([l for _, l in seen], losses)
+
+        def stop(step, loss):
+            raise StopIteration(f"enough at {step}")
+        with self.assertRaisesRegex(StopIteration, "enough at 2"):
+            hnn.HNN(2, hidden=(8,)).fit(x, dxdt, steps=9, callback=stop, record_every=2)
+
+    def test_ctrl_c_stops_fit_after_a_step(self):
+        x, dxdt = spring_data(256)
+        model = hnn.HNN(2, hidden=(64, 64), seed=0)
+        before = model.parameters()["mlp.layers.0.weight"]
+        timer = threading.Timer(0.3, os.kill, (os.getpid(), signal.SIGINT))
+        timer.start()
+        with self.assertRaises(KeyboardInterrupt):
+            model.fit(x, dxdt, steps=10**7, record_every=10**6)
+        timer.join()
+        self.assertFalse(np.array_equal(model.parameters()["mlp.layers.0.weight"], before))
+        model.vector_field(x)  # usable, at its last finished step
+        with self.assertRaises(KeyboardInterrupt):  # Python's own handler is back
+            os.kill(os.getpid(), signal.SIGINT)
+            threading.Event().wait(5)
 
     def test_float32_models_compute_in_float32(self):
         x, dxdt = spring_data()

@@ -51,16 +51,20 @@ def load(path, *, angles=0, kinetic_prior=1.0):
     return Model.load(str(path), angles=int(angles), kinetic_prior=float(kinetic_prior))
 
 
-def _fit(self, x, dxdt, steps=1000, lr=1e-3, batch=0, seed=0, record_every=1, weight_decay=0.0):
+def _fit(self, x, dxdt, steps=1000, lr=1e-3, batch=0, seed=0, record_every=1, weight_decay=0.0,
+         callback=None):
     """Trains on states x and their derivatives dxdt ([rows, dim] each) with Adam.
 
     The hnn program's loop and loss (the mean squared error of the field): `batch` rows drawn
     with replacement each step from `seed` (0: every row, every step). Returns the loss history:
-    the loss over every row at every `record_every`-th step and the last. Ctrl-C stops after
-    the current step, raising KeyboardInterrupt with the model at that step."""
+    the loss over every row at every `record_every`-th step and the last; `callback(step, loss)`
+    is called at each of them (an exception it raises ends the fit). Ctrl-C stops after the
+    current step, raising KeyboardInterrupt with the model at that step. The GIL is released
+    while it trains."""
     spec = _hnn._FitSpec()
     spec.steps, spec.lr, spec.batch, spec.seed = int(steps), float(lr), int(batch), int(seed)
     spec.record_every, spec.weight_decay = int(record_every), float(weight_decay)
+    spec.callback = callback
     return self._fit(x, dxdt, spec)
 
 
