@@ -89,6 +89,16 @@ py::array to_array(const Eigen::VectorXd& v) {
   return out;
 }
 
+py::array to_array(const physics::Trajectory& path) {
+  const Eigen::Index times = Eigen::Index(path.states.size());
+  const Eigen::Index rows = path.states.front().rows(), cols = path.states.front().cols();
+  py::array_t<double> out({py::ssize_t(times), py::ssize_t(rows), py::ssize_t(cols)});
+  for (Eigen::Index k = 0; k < times; ++k)
+    std::copy(path.states[k].data(), path.states[k].data() + rows * cols,
+              out.mutable_data() + k * rows * cols);
+  return out;
+}
+
 template Matrix<float> states(const py::handle&, std::string_view, Eigen::Index);
 template Matrix<double> states(const py::handle&, std::string_view, Eigen::Index);
 template py::array to_array(const Matrix<float>&);

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "autodiff/var.h"
+#include "physics/integrator.h"
 
 namespace hnn::python {
 
@@ -40,5 +41,7 @@ py::array to_array(const Matrix<T>& m);
 py::array to_array(const Eigen::VectorXd& v);
 template <typename T>
 py::array to_array(const Matrix<T>& m, std::vector<py::ssize_t> shape);
+/// A trajectory's states as one array [times, batch, dim].
+py::array to_array(const physics::Trajectory& path);
 
 }  // namespace hnn::python

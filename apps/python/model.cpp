@@ -180,10 +180,7 @@ py::array Model::rollout(const py::handle& x0, const py::handle& t, const std::s
     const auto in_double = visit([](const auto& m) { return nn::cast_model<double>(m); });
     path = stepper->integrate(tasks::learned_field(*in_double).field, start, times);
   }
-  Matrix<double> stacked(Eigen::Index(times.size()) * start.rows(), start.cols());
-  for (std::size_t k = 0; k < times.size(); ++k)
-    stacked.middleRows(Eigen::Index(k) * start.rows(), start.rows()) = path.states[k];
-  return to_array(stacked, {py::ssize_t(times.size()), start.rows(), start.cols()});
+  return to_array(path);
 }
 
 }  // namespace hnn::python

@@ -45,10 +45,7 @@ py::array simulate(const System& s, const py::handle& x0, const py::handle& t,
     py::gil_scoped_release free;
     path = physics::integrate_system(*stepper, s, start, times);
   }
-  Matrix<double> stacked(Eigen::Index(times.size()) * start.rows(), start.cols());
-  for (std::size_t k = 0; k < times.size(); ++k)
-    stacked.middleRows(Eigen::Index(k) * start.rows(), start.rows()) = path.states[k];
-  return to_array(stacked, {py::ssize_t(times.size()), start.rows(), start.cols()});
+  return to_array(path);
 }
 
 py::array initial_states(const System& s, int n, std::uint64_t seed) {
