@@ -3,6 +3,7 @@
 Run by ctest with PYTHONPATH at the built package (tests/CMakeLists.txt): python.Models,
 python.Errors, python.Systems, python.Programs."""
 
+import ast
 import csv
 import json
 import os
@@ -144,6 +145,20 @@ class Models(unittest.TestCase):
         ints = np.array([[1, 2], [0, -1]])
         np.testing.assert_array_equal(model.vector_field(ints),
                                       model.vector_field(ints.astype(float)))
+
+
+class Types(unittest.TestCase):
+    def test_the_pyi_names_every_public_member(self):
+        with open(os.path.join(os.path.dirname(hnn.__file__), "_hnn.pyi")) as f:
+            tree = ast.parse(f.read())
+        named = {n.name for n in ast.walk(tree)
+                 if isinstance(n, (ast.FunctionDef, ast.ClassDef))}
+        named |= {n.target.id for n in ast.walk(tree) if isinstance(n, ast.AnnAssign)}
+        members = [hnn._hnn, hnn.Model, hnn._hnn._FitSpec, hnn._hnn._systems,
+                   hnn.systems.System]
+        public = {name for m in members for name in vars(m)
+                  if not (name.startswith("__") or name in ("doc",))}
+        self.assertEqual(public - named - {"systems", "_systems"} - set(dir(object)), set())
 
 
 class Errors(unittest.TestCase):
