@@ -60,6 +60,30 @@ Matrix<T> states(const py::handle& obj, std::string_view what, Eigen::Index cols
   return Eigen::Map<const Matrix<T>>(c.data(), a.shape(0), cols);
 }
 
+std::vector<physics::Batch> trajectories(const py::handle& obj, std::string_view what,
+                                         Eigen::Index times, Eigen::Index dim) {
+  const py::array a = numeric(obj, what);
+  if (a.ndim() != 3 || a.shape(0) != times || a.shape(2) != dim) {
+    throw InputError(fmt::format("{}: expected a 3-D array [{} times, batch, {}], got shape {}",
+                                 what, times, dim, shape_text(a)));
+  }
+  if (a.shape(1) == 0)
+    throw InputError(fmt::format("{}: the array is empty (no trajectories)", what));
+  const auto c = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(a);
+  const Eigen::Index batch = a.shape(1);
+  std::vector<physics::Batch> paths(std::size_t(batch), physics::Batch(times, dim));
+  for (Eigen::Index k = 0; k < times; ++k) {
+    for (Eigen::Index b = 0; b < batch; ++b) {
+      auto row = paths[std::size_t(b)].row(k);
+      row = Eigen::Map<const Eigen::RowVectorXd>(c.data() + (k * batch + b) * dim, dim);
+      if (!row.allFinite())
+        throw InputError(
+            fmt::format("{}: NaN or infinity at time {} of trajectory {}", what, k, b));
+    }
+  }
+  return paths;
+}
+
 std::vector<double> times(const py::handle& obj, std::string_view what) {
   const py::array a = numeric(obj, what);
   if (a.ndim() != 1)

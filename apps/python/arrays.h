@@ -31,6 +31,10 @@ using Matrix = ad::Matrix<T>;
 /// numeric array with `cols` columns, at least one row, and only finite values.
 template <typename T>
 Matrix<T> states(const py::handle& obj, std::string_view what, Eigen::Index cols);
+/// `obj` as a 3-D array [times, batch, dim] (as simulate and rollout return), one matrix
+/// [times, dim] per trajectory; throws InputError naming `what` like states().
+std::vector<physics::Batch> trajectories(const py::handle& obj, std::string_view what,
+                                         Eigen::Index times, Eigen::Index dim);
 /// `obj` as a 1-D array of finite times, at least one; throws InputError naming `what`.
 std::vector<double> times(const py::handle& obj, std::string_view what);
 

@@ -34,6 +34,11 @@ struct FitSpec {
   long record_every = 1;
   double weight_decay = 0;
   py::object callback = py::none();  // called with (step, loss) at each loss-history point
+  // The rollout loss's (fit_rollout): sampling intervals per window, the integrator, its step
+  // (0: one step per interval).
+  int horizon = 1;
+  std::string integrator = "rk4";
+  double dt = 0;
 };
 
 class Model {
@@ -59,11 +64,19 @@ class Model {
   void save(const std::filesystem::path& path) const;
   /// Trains on (x, dxdt) with the library's loop and field objective; the loss history.
   py::array fit(const py::handle& x, const py::handle& dxdt, const FitSpec& spec);
+  /// Trains through an integrator on trajectories [len(t), batch, dim] at times t (the rollout
+  /// loss, tasks/train/rollout_objective.h); the loss history.
+  py::array fit_rollout(const py::handle& paths, const py::handle& t, const FitSpec& spec);
   /// The model's field integrated from each row of x0 at t[0]: [len(t), batch, dim], float64.
   py::array rollout(const py::handle& x0, const py::handle& t, const std::string& integrator,
                     double rtol, double dt) const;
 
  private:
+  /// Runs `train(model, stop)` with the GIL released and Ctrl-C as a stop request; the train
+  /// losses of the curve it returns.
+  template <typename Train>
+  py::array trained(Train&& train);
+
   template <typename F>
   decltype(auto) visit(F&& f) const {
     return std::visit([&](const auto& m) -> decltype(auto) { return f(*m); }, model_);

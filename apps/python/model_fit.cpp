@@ -1,5 +1,6 @@
-// hnn.Model.fit, on the library's training loop (tasks/train/loop.h) and field objective
-// (tasks/train/field_objective.h), and the bindings of hnn.Model.
+// hnn.Model.fit, on the library's training loop (tasks/train/loop.h) and its objectives: the
+// field's (tasks/train/field_objective.h) and through an integrator
+// (tasks/train/rollout_objective.h); and the bindings of hnn.Model.
 
 #include <fmt/format.h>
 #include <pybind11/stl.h>
@@ -11,28 +12,28 @@
 #include "tasks/error.h"
 #include "tasks/train/field_objective.h"
 #include "tasks/train/loop.h"
+#include "tasks/train/rollout_objective.h"
 
 namespace hnn::python {
 
 namespace {
 
-// The field objective, keeping its last loss-curve point for fit's callback.
-template <typename T>
-class ReportingObjective : public tasks::FieldObjective<T> {
+// An objective of tasks/train/ keeping its last loss-curve point for fit's callback.
+template <class Objective>
+class Reporting : public Objective {
  public:
-  using tasks::FieldObjective<T>::FieldObjective;
+  using Objective::Objective;
   tasks::CurvePoint curve_point(long step, double batch_loss) const override {
-    last = tasks::FieldObjective<T>::curve_point(step, batch_loss);
+    last = Objective::curve_point(step, batch_loss);
     return last;
   }
   mutable tasks::CurvePoint last{};
 };
 
-template <typename T>
-tasks::TrainResult fit_model(nn::DynamicsModel<T>& model, const tasks::Dataset& data,
-                             const FitSpec& spec, tasks::StopSignal* stop) {
-  ReportingObjective<T> objective(model, data, spec.batch,
-                                  {.lr = spec.lr, .weight_decay = spec.weight_decay}, spec.seed);
+// The training loop on `objective`, quiet, with fit's callback at each loss-curve point.
+template <class Objective>
+tasks::TrainResult run_loop(Reporting<Objective>& objective, const FitSpec& spec,
+                            tasks::StopSignal* stop) {
   tasks::LoopOptions loop{.steps = spec.steps,
                           .record_every = spec.record_every,
                           .quiet = true,
@@ -47,7 +48,43 @@ tasks::TrainResult fit_model(nn::DynamicsModel<T>& model, const tasks::Dataset& 
   return tasks::train(objective, loop);
 }
 
+void check_spec(const FitSpec& spec, Eigen::Index rows, std::string_view what) {
+  HNN_TASKS_CHECK(spec.batch >= 0 && spec.batch <= rows,
+                  "batch must be 0 (the full batch) to {} (the {}), got {}", rows, what,
+                  spec.batch);
+  HNN_TASKS_CHECK(spec.record_every >= 1, "record_every must be >= 1, got {}", spec.record_every);
+}
+
+// Each trajectory of `paths` ([times, batch, dim]) as a stretch at times t.
+std::vector<tasks::Stretch> stretches(const py::handle& paths, const py::handle& t,
+                                      Eigen::Index dim) {
+  const std::vector<double> times = python::times(t, "t");
+  std::vector<tasks::Stretch> out;
+  for (physics::Batch& path : trajectories(paths, "trajectories", Eigen::Index(times.size()), dim))
+    out.push_back({Eigen::Map<const Eigen::VectorXd>(times.data(), Eigen::Index(times.size())),
+                   std::move(path)});
+  return out;
+}
+
 }  // namespace
+
+template <typename Train>
+py::array Model::trained(Train&& train) {
+  tasks::TrainResult result;
+  {
+    Interrupt interrupt;
+    try {
+      py::gil_scoped_release free;
+      result = std::visit([&](auto& m) { return train(*m, interrupt.signal()); }, model_);
+    } catch (const tasks::TrainingInterrupted&) {
+      Interrupt::raise_keyboard_interrupt();  // the model is left at its last finished step
+    }
+  }
+  Eigen::VectorXd losses(Eigen::Index(result.curve.size()));
+  for (std::size_t i = 0; i < result.curve.size(); ++i)
+    losses(Eigen::Index(i)) = result.curve[i].train_loss;
+  return to_array(losses);
+}
 
 py::array Model::fit(const py::handle& x, const py::handle& dxdt, const FitSpec& spec) {
   const Eigen::Index dim = config().dim;
@@ -58,25 +95,26 @@ py::array Model::fit(const py::handle& x, const py::handle& dxdt, const FitSpec&
   if (data.train_dxdt.rows() != data.train_x.rows())
     throw InputError(fmt::format("dxdt: expected {} rows, one per state of x, got {}",
                                  data.train_x.rows(), data.train_dxdt.rows()));
-  HNN_TASKS_CHECK(spec.batch >= 0 && spec.batch <= data.train_x.rows(),
-                  "batch must be 0 (the full batch) to {} (the rows of x), got {}",
-                  data.train_x.rows(), spec.batch);
-  HNN_TASKS_CHECK(spec.record_every >= 1, "record_every must be >= 1, got {}", spec.record_every);
-  tasks::TrainResult result;
-  {
-    Interrupt interrupt;
-    try {
-      py::gil_scoped_release free;
-      result = std::visit([&](auto& m) { return fit_model(*m, data, spec, interrupt.signal()); },
-                          model_);
-    } catch (const tasks::TrainingInterrupted&) {
-      Interrupt::raise_keyboard_interrupt();  // the model is left at its last finished step
-    }
-  }
-  Eigen::VectorXd losses(Eigen::Index(result.curve.size()));
-  for (std::size_t i = 0; i < result.curve.size(); ++i)
-    losses(Eigen::Index(i)) = result.curve[i].train_loss;
-  return to_array(losses);
+  check_spec(spec, data.train_x.rows(), "rows of x");
+  const nn::AdamOptions adam{.lr = spec.lr, .weight_decay = spec.weight_decay};
+  return trained([&]<typename T>(nn::DynamicsModel<T>& m, tasks::StopSignal* stop) {
+    Reporting<tasks::FieldObjective<T>> objective(m, data, spec.batch, adam, spec.seed);
+    return run_loop(objective, spec, stop);
+  });
+}
+
+py::array Model::fit_rollout(const py::handle& paths, const py::handle& t, const FitSpec& spec) {
+  const tasks::RolloutWindows windows =
+      tasks::rollout_windows(stretches(paths, t, config().dim), spec.horizon);
+  const int substeps = tasks::rollout_substeps(windows, spec.dt);
+  const tasks::RolloutIntegrator integrator = tasks::parse_rollout_integrator(spec.integrator);
+  check_spec(spec, windows.count(), "rollout windows");
+  const nn::AdamOptions adam{.lr = spec.lr, .weight_decay = spec.weight_decay};
+  return trained([&]<typename T>(nn::DynamicsModel<T>& m, tasks::StopSignal* stop) {
+    Reporting<tasks::RolloutObjective<T>> objective(m, windows, tasks::RolloutWindows{}, spec.batch,
+                                                    adam, spec.seed, integrator, substeps);
+    return run_loop(objective, spec, stop);
+  });
 }
 
 void bind_model(py::module_& m) {
@@ -88,7 +126,10 @@ void bind_model(py::module_& m) {
       .def_readwrite("seed", &FitSpec::seed)
       .def_readwrite("record_every", &FitSpec::record_every)
       .def_readwrite("weight_decay", &FitSpec::weight_decay)
-      .def_readwrite("callback", &FitSpec::callback);
+      .def_readwrite("callback", &FitSpec::callback)
+      .def_readwrite("horizon", &FitSpec::horizon)
+      .def_readwrite("integrator", &FitSpec::integrator)
+      .def_readwrite("dt", &FitSpec::dt);
   py::class_<Model>(m, "Model",
                     "A learned dynamics model: hnn.HNN, hnn.DHNN, hnn.Baseline, hnn.LNN.")
       .def(py::init([](const std::string& kind, long dim, std::vector<long> hidden,
@@ -125,6 +166,8 @@ void bind_model(py::module_& m) {
       .def("save", &Model::save, py::arg("path"),
            "Writes the parameters in the hnn program's file format (params.bin)")
       .def("_fit", &Model::fit, py::arg("x"), py::arg("dxdt"), py::arg("spec"))
+      .def("_fit_rollout", &Model::fit_rollout, py::arg("trajectories"), py::arg("t"),
+           py::arg("spec"))
       .def("rollout", &Model::rollout, py::arg("x0"), py::arg("t"),
            py::arg("integrator") = "dopri5", py::arg("rtol") = 1e-9, py::arg("dt") = 1e-2,
            "The learned field integrated from each row of x0 at t[0], [len(t), batch, dim]");

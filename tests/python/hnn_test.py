@@ -42,6 +42,16 @@ class Models(unittest.TestCase):
             self.assertEqual(losses.shape, (60,))
             self.assertLess(losses[-1], 0.2 * losses[0], make.__name__)
 
+    def test_fit_through_an_integrator_lowers_the_loss(self):
+        spring = hnn.systems.Spring()
+        t = np.linspace(0, 2, 21)
+        paths = spring.simulate(spring.initial_states(16, seed=0), t)
+        for integrator in ("leapfrog", "rk4"):
+            model = hnn.HNN(2, hidden=(16, 16), seed=0)
+            losses = model.fit(paths, t, loss="rollout", horizon=3, integrator=integrator,
+                               steps=60, lr=1e-2, batch=32)
+            self.assertLess(losses[-1], 0.2 * losses[0], integrator)
+
     def test_fit_is_seeded_and_batched(self):
         x, dxdt = spring_data()
         runs = [hnn.HNN(2, hidden=(8,), seed=0).fit(x, dxdt, steps=10, batch=16, seed=s,
@@ -191,6 +201,14 @@ class Errors(unittest.TestCase):
         self.expect("activation", hnn.HNN, 2, activation="cube")
         self.expect("t: expected a 1-D array of times", self.model.rollout, x, [[0, 1]])
         self.expect("integrator", self.model.rollout, x, [0, 1], integrator="magic")
+        paths, t = np.zeros((5, 2, 2)), np.linspace(0, 1, 5)
+        self.expect(r"trajectories: expected a 3-D array \[5 times, batch, 2\], got shape "
+                    r"\(5, 2\)", self.model.fit, paths[:, 0], t, loss="rollout")
+        self.expect("horizon of 9 steps is past the end", self.model.fit, paths, t,
+                    loss="rollout", horizon=9)
+        self.expect("integrator 'euler'", self.model.fit, paths, t, loss="rollout",
+                    integrator="euler")
+        self.expect("loss must be derivative or rollout", self.model.fit, paths, t, loss="l2")
         self.expect("unknown parameter 'w'", self.model.set_parameters, {"w": np.zeros((1, 1))})
 
     def test_bad_files(self):

@@ -51,21 +51,34 @@ def load(path, *, angles=0, kinetic_prior=1.0):
     return Model.load(str(path), angles=int(angles), kinetic_prior=float(kinetic_prior))
 
 
-def _fit(self, x, dxdt, steps=1000, lr=1e-3, batch=0, seed=0, record_every=1, weight_decay=0.0,
-         callback=None):
-    """Trains on states x and their derivatives dxdt ([rows, dim] each) with Adam.
+def _fit(self, x, target, steps=1000, lr=1e-3, batch=0, seed=0, record_every=1,
+         weight_decay=0.0, callback=None, loss="derivative", horizon=1, integrator="rk4",
+         dt=0.0):
+    """Trains with Adam, on the hnn program's loop and losses; returns the loss history.
 
-    The hnn program's loop and loss (the mean squared error of the field): `batch` rows drawn
-    with replacement each step from `seed` (0: every row, every step). Returns the loss history:
-    the loss over every row at every `record_every`-th step and the last; `callback(step, loss)`
-    is called at each of them (an exception it raises ends the fit). Ctrl-C stops after the
-    current step, raising KeyboardInterrupt with the model at that step. The GIL is released
-    while it trains."""
+    loss="derivative" (the default): x and target are states and their derivatives dx/dt,
+    [rows, dim] each; the loss is the mean squared error of the field, and `batch` rows are
+    drawn with replacement each step from `seed` (0: every row, every step).
+    loss="rollout": x is trajectories [len(t), batch, dim] (as simulate returns them) and
+    target their times t; the field is integrated `horizon` sampling intervals from each state
+    with `integrator` (rk4, leapfrog, yoshida4 or midpoint; steps of `dt`, which must divide
+    the interval, or one per interval for 0) and compared with the states there; `batch`
+    windows per step (0: all). No derivatives are needed.
+
+    The history is the loss over every row (window) at every `record_every`-th step and the
+    last; `callback(step, loss)` is called at each of them (an exception it raises ends the
+    fit). Ctrl-C stops after the current step, raising KeyboardInterrupt with the model at
+    that step. The GIL is released while it trains."""
     spec = _hnn._FitSpec()
     spec.steps, spec.lr, spec.batch, spec.seed = int(steps), float(lr), int(batch), int(seed)
     spec.record_every, spec.weight_decay = int(record_every), float(weight_decay)
     spec.callback = callback
-    return self._fit(x, dxdt, spec)
+    spec.horizon, spec.integrator, spec.dt = int(horizon), str(integrator), float(dt)
+    if loss == "derivative":
+        return self._fit(x, target, spec)
+    if loss == "rollout":
+        return self._fit_rollout(x, target, spec)
+    raise Error(f"loss must be derivative or rollout, got {loss!r}")
 
 
 Model.fit = _fit
