@@ -62,6 +62,11 @@ class Model {
   py::dict parameters() const;
   void set_parameters(const py::dict& values);
   void save(const std::filesystem::path& path) const;
+  /// The learned scalar (an HNN's H, an LNN's L) differentiated `order` times in the state,
+  /// row by row: [batch, dim, ..., dim] (autodiff.cpp).
+  py::array derivative(const py::handle& x, int order) const;
+  /// d f / dx of the field, row by row: [batch, dim (f), dim (x)].
+  py::array field_jacobian(const py::handle& x) const;
   /// Trains on (x, dxdt) with the library's loop and field objective; the loss history.
   py::array fit(const py::handle& x, const py::handle& dxdt, const FitSpec& spec);
   /// Trains through an integrator on trajectories [len(t), batch, dim] at times t (the rollout
@@ -89,5 +94,7 @@ class Model {
 
 /// Adds hnn.Model to the module.
 void bind_model(py::module_& m);
+/// Adds the compiled half of hnn.autodiff.
+void bind_autodiff(py::module_& m);
 
 }  // namespace hnn::python

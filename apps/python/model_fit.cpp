@@ -165,6 +165,8 @@ void bind_model(py::module_& m) {
            "Sets every parameter from a dict like parameters()'s (all or none)")
       .def("save", &Model::save, py::arg("path"),
            "Writes the parameters in the hnn program's file format (params.bin)")
+      .def("_derivative", &Model::derivative, py::arg("x"), py::arg("order"))
+      .def("_field_jacobian", &Model::field_jacobian, py::arg("x"))
       .def("_fit", &Model::fit, py::arg("x"), py::arg("dxdt"), py::arg("spec"))
       .def("_fit_rollout", &Model::fit_rollout, py::arg("trajectories"), py::arg("t"),
            py::arg("spec"))

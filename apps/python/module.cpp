@@ -44,4 +44,5 @@ PYBIND11_MODULE(_hnn, m) {
   hnn::python::bind_model(m);
   hnn::python::bind_systems(m);
   hnn::python::bind_runs(m);
+  hnn::python::bind_autodiff(m);
 }

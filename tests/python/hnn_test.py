@@ -157,6 +157,50 @@ class Models(unittest.TestCase):
                                       model.vector_field(ints.astype(float)))
 
 
+def central_difference(f, x, eps=1e-6):
+    """d f / dx_j at each row of x by central differences, stacked on a new last axis."""
+    return np.stack([(f(x + eps * e) - f(x - eps * e)) / (2 * eps) for e in np.eye(x.shape[1])],
+                    axis=-1)
+
+
+class Autodiff(unittest.TestCase):
+    x = np.array([[0.3, -0.2, 0.1, 0.7], [1.0, 0.5, -0.4, 0.2]])
+
+    def test_model_derivatives_to_third_order_match_differences(self):
+        for model in (hnn.HNN(4, hidden=(8, 8), seed=1), hnn.LNN(4, hidden=(8,), seed=2),
+                      hnn.DHNN(4, hidden=(8,), seed=3)):
+            d = [hnn.autodiff.derivative(model, self.x, k) for k in range(4)]
+            self.assertEqual([a.shape for a in d], [(2,), (2, 4), (2, 4, 4), (2, 4, 4, 4)])
+            for k in range(3):
+                order = k
+                fd = central_difference(
+                    lambda x: hnn.autodiff.derivative(model, x, order), self.x)
+                np.testing.assert_allclose(d[k + 1], fd, rtol=1e-6, atol=1e-8)
+            np.testing.assert_array_equal(hnn.autodiff.grad(model, self.x), d[1])
+            np.testing.assert_array_equal(hnn.autodiff.hessian(model, self.x), d[2])
+        hnn_model = hnn.HNN(4, hidden=(8,), seed=4)
+        np.testing.assert_array_equal(hnn.autodiff.derivative(hnn_model, self.x, 0),
+                                      hnn_model.hamiltonian(self.x))
+
+    def test_field_jacobian_and_system_gradient_match_differences(self):
+        for model in (hnn.HNN(4, hidden=(8,), seed=1), hnn.Baseline(4, hidden=(8,), seed=1)):
+            np.testing.assert_allclose(hnn.autodiff.jacobian(model, self.x),
+                                       central_difference(model.vector_field, self.x),
+                                       rtol=1e-6, atol=1e-8)
+        pendulum = hnn.systems.DoublePendulum()
+        np.testing.assert_allclose(hnn.autodiff.grad(pendulum, self.x),
+                                   central_difference(pendulum.hamiltonian, self.x),
+                                   rtol=1e-6, atol=1e-8)
+
+    def test_what_it_refuses(self):
+        with self.assertRaisesRegex(hnn.Error, "a baseline model learns no scalar H or L"):
+            hnn.autodiff.grad(hnn.Baseline(4, hidden=(4,)), self.x)
+        with self.assertRaisesRegex(hnn.Error, "order must be 0 to 6, got 7"):
+            hnn.autodiff.derivative(hnn.HNN(4, hidden=(4,)), self.x, 7)
+        with self.assertRaisesRegex(hnn.Error, "order 1 only"):
+            hnn.autodiff.hessian(hnn.systems.Spring(), self.x[:, :2])
+
+
 class Types(unittest.TestCase):
     def test_the_pyi_names_every_public_member(self):
         with open(os.path.join(os.path.dirname(hnn.__file__), "_hnn.pyi")) as f:

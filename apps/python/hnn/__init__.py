@@ -6,11 +6,11 @@ same shape. Models compute in float64 unless made with dtype="float32". See docs
 
 from . import _hnn
 from ._hnn import Error, Model, set_threads, threads
-from . import systems
+from . import autodiff, systems
 from .runs import Run, load_run, train
 
 __all__ = ["HNN", "DHNN", "Baseline", "LNN", "Model", "Error", "load", "train", "load_run",
-           "Run", "systems", "set_threads", "threads"]
+           "Run", "systems", "autodiff", "set_threads", "threads"]
 
 
 def _make(kind, dim, hidden, activation, dtype, seed, angles=0, kinetic_prior=1.0):
