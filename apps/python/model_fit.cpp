@@ -152,7 +152,8 @@ void bind_model(py::module_& m) {
            py::arg("dtype"), py::arg("seed"), py::arg("angles"), py::arg("kinetic_prior"))
       .def_static("load", &Model::load, py::arg("path"), py::arg("angles") = 0,
                   py::arg("kinetic_prior") = 1.0)
-      .def_property_readonly("dim", [](const Model& self) { return self.config().dim; })
+      .def_property_readonly(
+          "dim", [](const Model& self) { return self.config().dim; }, "The state's size 2n")
       .def_property_readonly("kind", &Model::name, "hnn, hnn-dissipative, baseline or lnn")
       .def_property_readonly("dtype", &Model::dtype, "float32 or float64")
       .def("__repr__", [](const Model& self) { return "<hnn.Model " + self.describe() + ">"; })

@@ -21,6 +21,9 @@ PYBIND11_MODULE(_hnn, m) {
   // hnn.Error: the library's one-line messages on bad input (a ValueError); a diverged
   // training run is a RuntimeError.
   static py::exception<hnn::python::InputError> error(m, "Error", PyExc_ValueError);
+  error.attr("__doc__") =
+      "Bad input to hnn (an array, an option, a file): one line saying what "
+      "and where. A ValueError.";
   py::register_exception_translator([](std::exception_ptr p) {
     try {
       if (p) std::rethrow_exception(p);

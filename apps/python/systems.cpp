@@ -59,8 +59,8 @@ py::array initial_states(const System& s, int n, std::uint64_t seed) {
 void bind_systems(py::module_& m) {
   py::module_ s = m.def_submodule("_systems", "The library's Hamiltonian systems");
   py::class_<System, SystemPtr>(s, "System", "A Hamiltonian system in x = (q, p)")
-      .def_property_readonly("dim", &System::dim)
-      .def_property_readonly("name", &System::name)
+      .def_property_readonly("dim", &System::dim, "The state's size 2n")
+      .def_property_readonly("name", &System::name, "The system's name (an expression's H)")
       .def("__repr__",
            [](const System& self) { return "<hnn.systems.System " + self.name() + ">"; })
       .def("hamiltonian", &system_hamiltonian, py::arg("x"), "H at each state of x, [batch]")

@@ -9,6 +9,7 @@ import json
 import os
 import signal
 import subprocess
+import sys
 import tempfile
 import threading
 import unittest
@@ -215,6 +216,30 @@ class Types(unittest.TestCase):
         self.assertEqual(public - named - {"systems", "_systems"} - set(dir(object)), set())
 
 
+    def test_every_public_name_has_a_docstring(self):
+        modules = [hnn, hnn.systems, hnn.autodiff]
+        names = [(m.__name__, n, getattr(m, n)) for m in modules for n in m.__all__]
+        names += [("hnn.Model", n, getattr(hnn.Model, n)) for n in vars(hnn.Model)
+                  if not n.startswith("_")]
+        names += [("System", n, getattr(hnn.systems.System, n))
+                  for n in vars(hnn.systems.System) if not n.startswith("_")]
+        missing = [f"{m}.{n}" for m, n, v in names
+                   if not (getattr(v, "__doc__", None) or "").strip()]
+        self.assertEqual(missing, [])
+
+    def test_works_without_matplotlib_or_a_display(self):
+        code = ("import sys; sys.modules['matplotlib'] = None\n"
+                "import hnn\n"
+                "m = hnn.HNN(2, hidden=(4,))\n"
+                "m.fit([[0.1, 0.2], [0.3, 0.4]], [[1.0, 0.0], [0.0, 1.0]], steps=2)\n"
+                "print(m.vector_field([[0.0, 1.0]]).shape)\n")
+        env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "MPLBACKEND")}
+        result = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True,
+                                text=True)
+        self.assertEqual((result.returncode, result.stdout.strip()), (0, "(1, 2)"),
+                         result.stderr)
+
+
 class Errors(unittest.TestCase):
     def setUp(self):
         self.model = hnn.HNN(2, hidden=(4,))
@@ -339,6 +364,8 @@ class Programs(unittest.TestCase):
         np.testing.assert_array_equal(curve["train_loss"], cli.loss_curve["train_loss"])
         self.assertEqual(run.rollouts["hnn"]["x"].shape[2], 2)
         np.testing.assert_array_equal(run.rollouts["true"]["x"], cli.rollouts["true"]["x"])
+        evaluated = json.loads(run_hnn("evaluate", run.path, "--json", cwd=self.dir))
+        self.assertEqual(evaluated["test_loss"], run.metrics["test_loss"])  # the program reads it
 
     def test_a_model_saved_from_python_runs_in_the_program(self):
         # The run's own model, its weights changed from Python and saved into a copy of the run:
