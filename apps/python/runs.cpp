@@ -13,6 +13,7 @@
 #include "apps/hnn/sweep/keys.h"
 #include "apps/python/arrays.h"
 #include "apps/python/interrupt.h"
+#include "autodiff/parallel.h"
 #include "tasks/run.h"
 #include "tasks/train_options.h"
 
@@ -89,12 +90,25 @@ tasks::RunOptions run_options(const std::string& task, const json& given) {
   return o;
 }
 
+// Restores the engine's thread count, which a run sets to its own (--threads), when it ends.
+class KeepThreads {
+ public:
+  KeepThreads() : threads_(ad::num_threads()) {}
+  ~KeepThreads() { ad::set_num_threads(threads_); }
+  KeepThreads(const KeepThreads&) = delete;
+  KeepThreads& operator=(const KeepThreads&) = delete;
+
+ private:
+  int threads_;
+};
+
 // Trains and writes the run folder; returns its path. Ctrl-C stops after the step, with a
 // checkpoint, and raises KeyboardInterrupt (resume with hnn train --resume).
 std::string train(const std::string& task, const std::string& options_json) {
   tasks::RunOptions o = run_options(task, json::parse(options_json));
   Interrupt interrupt;
   o.stop = interrupt.signal();
+  const KeepThreads keep;
   try {
     py::gil_scoped_release free;
     tasks::run_training(o);

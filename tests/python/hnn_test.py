@@ -352,8 +352,10 @@ class Programs(unittest.TestCase):
         cls.tmp.cleanup()
 
     def test_train_gives_the_programs_metrics(self):
+        hnn.set_threads(1)
         run = hnn.train("spring", out=os.path.join(self.dir, "py"), steps=20, hidden=[8, 8],
                         lr=0.01, quiet=True)
+        self.assertEqual(hnn.threads(), 1)  # the run's --threads 2 did not stay
         cli = hnn.load_run(os.path.join(self.dir, "cli"))
         timing = {k for k in cli.metrics if k.endswith("seconds")}
         self.assertTrue(timing)
