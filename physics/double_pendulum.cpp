@@ -7,8 +7,9 @@
 
 namespace hnn::physics {
 
-DoublePendulum::DoublePendulum(double m1, double m2, double l1, double l2, double g)
-    : m1_(m1), m2_(m2), l1_(l1), l2_(l2), g_(g) {
+DoublePendulum::DoublePendulum(double m1, double m2, double l1, double l2, double g,
+                               PotentialZero zero)
+    : m1_(m1), m2_(m2), l1_(l1), l2_(l2), g_(g), zero_(zero) {
   for (double v : {m1, m2, l1, l2, g}) {
     if (!(v > 0.0) || !std::isfinite(v)) {
       throw std::invalid_argument("DoublePendulum masses, lengths and g must be positive");
@@ -26,8 +27,9 @@ Eigen::VectorXd DoublePendulum::hamiltonian_batch(const Batch& x) const {
   const Eigen::ArrayXd num = m2_ * l2_ * l2_ * p1.square() + (m1_ + m2_) * l1_ * l1_ * p2.square() -
                              2.0 * m2_ * l1_ * l2_ * p1 * p2 * d.cos();
   const Eigen::ArrayXd kinetic = num / (2.0 * m2_ * l1_ * l1_ * l2_ * l2_ * big_d);
+  const double rest = zero_ == PotentialZero::kAtRest ? 1.0 : 0.0;
   const Eigen::ArrayXd potential =
-      (m1_ + m2_) * g_ * l1_ * (1.0 - t1.cos()) + m2_ * g_ * l2_ * (1.0 - t2.cos());
+      (m1_ + m2_) * g_ * l1_ * (rest - t1.cos()) + m2_ * g_ * l2_ * (rest - t2.cos());
   return (kinetic + potential).matrix();
 }
 

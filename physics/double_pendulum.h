@@ -13,8 +13,14 @@ namespace hnn::physics {
 /// and V = (m1+m2) g l1 (1 - cos theta1) + m2 g l2 (1 - cos theta2). Not separable.
 class DoublePendulum : public System {
  public:
+  /// Where V is zero: at rest hanging down (the default, above), or with the masses level with
+  /// the pivot, V = -(m1+m2) g l1 cos theta1 - m2 g l2 cos theta2 (the sampled-HNN paper's code,
+  /// hamiltonian/double_pendulum.py). The field is the same; H differs by a constant, which
+  /// matters to an error relative to H's size.
+  enum class PotentialZero { kAtRest, kAtPivot };
+
   DoublePendulum(double m1 = 1.0, double m2 = 1.0, double l1 = 1.0, double l2 = 1.0,
-                 double g = 9.81);
+                 double g = 9.81, PotentialZero zero = PotentialZero::kAtRest);
 
   int dim() const override { return 4; }
   std::string name() const override { return "double_pendulum"; }
@@ -30,6 +36,7 @@ class DoublePendulum : public System {
 
  private:
   double m1_, m2_, l1_, l2_, g_;
+  PotentialZero zero_;
 };
 
 /// The same double pendulum in angles and angular velocities x = (theta1, theta2, omega1,

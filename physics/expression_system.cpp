@@ -254,13 +254,7 @@ std::optional<SplitField> ExpressionSystem::separable_split() const {
 }
 
 Batch ExpressionSystem::sample_box(int n, std::mt19937_64& rng) const {
-  Batch x(n, dim());
-  for (Eigen::Index i = 0; i < n; ++i) {
-    for (int j = 0; j < dim(); ++j) {
-      x(i, j) = std::uniform_real_distribution<double>(box_[j].lo, box_[j].hi)(rng);
-    }
-  }
-  return x;
+  return physics::sample_box(n, box_, rng);
 }
 
 Batch ExpressionSystem::sample_initial_states(int n, std::mt19937_64& rng) const {

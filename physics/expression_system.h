@@ -13,12 +13,6 @@
 
 namespace hnn::physics {
 
-/// A closed interval [lo, hi].
-struct ValueRange {
-  double lo = -1.0;
-  double hi = 1.0;
-};
-
 /// How an ExpressionSystem draws initial states: every variable uniform in its range
 /// ([-1, 1] unless named here), and with an energy band only states whose H lies in it
 /// (drawn from the box, the others rejected).

@@ -28,6 +28,17 @@ VectorField System::field() const {
   };
 }
 
+Batch sample_box(int n, const std::vector<ValueRange>& box, std::mt19937_64& rng) {
+  Batch x(n, Eigen::Index(box.size()));
+  for (Eigen::Index i = 0; i < x.rows(); ++i) {
+    for (Eigen::Index j = 0; j < x.cols(); ++j) {
+      const ValueRange& r = box[std::size_t(j)];
+      x(i, j) = std::uniform_real_distribution<double>(r.lo, r.hi)(rng);
+    }
+  }
+  return x;
+}
+
 SplitField split_field(const VectorField& f) {
   // The scratch full derivative is shared by both halves; each call refills it.
   auto full = std::make_shared<Batch>();

@@ -5,6 +5,7 @@
 #include <optional>
 #include <random>
 #include <string>
+#include <vector>
 
 #include "physics/types.h"
 
@@ -55,6 +56,10 @@ class System {
   /// H is not separable (the default). Refers to *this, like field().
   virtual std::optional<SplitField> separable_split() const { return std::nullopt; }
 };
+
+/// n states drawn uniformly in a box: column j uniform in box[j], drawn row by row (each row's
+/// columns in order), so a seed gives the same states whatever n is for the rows they share.
+Batch sample_box(int n, const std::vector<ValueRange>& box, std::mt19937_64& rng);
 
 /// Splits a general field by evaluating it in full and keeping one half. Right
 /// only when the field is separable; each half costs one full evaluation.

@@ -12,6 +12,12 @@ namespace hnn::physics {
 /// Row-major so that each state is contiguous.
 using Batch = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
+/// A closed interval [lo, hi].
+struct ValueRange {
+  double lo = -1.0;
+  double hi = 1.0;
+};
+
 /// Read-only view of a batch or of a column block of one (e.g. the p half), no copy.
 using BatchView = Eigen::Ref<const Batch>;
 

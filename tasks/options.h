@@ -12,13 +12,17 @@
 #include <vector>
 
 #include "nn/dynamics.h"
+#include "tasks/train/fit_method.h"
 #include "tasks/train/loop.h"
 #include "tasks/train/rollout_objective.h"
 
 namespace hnn::tasks {
 
-/// The widest hidden layer a run may ask for (a typo like 20000 would need gigabytes).
-inline constexpr int kMaxWidth = 4096;
+/// The widest hidden layer a run may ask for (a typo like 50000 would need gigabytes): a sampled
+/// fit's (the peer protocols' 5000 wide layers, tasks/train/fit_method.h); Adam's steps take at
+/// most kMaxAdamWidth.
+inline constexpr int kMaxWidth = 8192;
+inline constexpr int kMaxAdamWidth = 4096;
 
 /// How a model is trained. Every field can be overridden from the command line.
 struct TrainConfig {
@@ -73,6 +77,9 @@ struct RunSettings {
   /// by resolve() (tasks/run.h): what the field tasks train with. task_settings keeps them as
   /// given, so that metrics.json and checkpoints record them as before.
   RolloutLossConfig loss{};
+  /// The fit keys of task_settings ("fit", "sampler", "rcond"), parsed once by resolve(): Adam,
+  /// or sampled hidden layers with the last layer by least squares (tasks/train/fit_method.h).
+  FitConfig fit{};
 
   /// The form metrics.json and checkpoints hold ("hidden": "200-200").
   nlohmann::json to_json() const;

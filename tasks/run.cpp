@@ -10,6 +10,7 @@
 #include "tasks/data/file_digest.h"
 #include "tasks/data/initial_states.h"
 #include "tasks/experiments/registry.h"
+#include "tasks/fit_options.h"
 #include "tasks/report/json_values.h"
 #include "tasks/train/checkpoint.h"
 
@@ -20,8 +21,8 @@ using nlohmann::json;
 
 namespace {
 
-void check_train_config(const TrainConfig& c) {
-  HNN_TASKS_CHECK(c.steps > 0, "--steps must be positive, got {}", c.steps);
+void check_train_config(const TrainConfig& c, const FitConfig& fit) {
+  HNN_TASKS_CHECK(c.steps > 0 || !fit.steps(), "--steps must be positive, got {}", c.steps);
   HNN_TASKS_CHECK(c.batch_size >= 0, "--batch must be >= 0, got {}", c.batch_size);
   HNN_TASKS_CHECK(c.learning_rate > 0 && std::isfinite(c.learning_rate),
                   "--lr must be a positive finite number, got {}", c.learning_rate);
@@ -30,12 +31,17 @@ void check_train_config(const TrainConfig& c) {
   HNN_TASKS_CHECK(!c.hidden.empty(), "--hidden needs at least one width");
   for (int w : c.hidden) {
     HNN_TASKS_CHECK(w > 0 && w <= kMaxWidth, "--hidden widths must be 1..{}, got {}", kMaxWidth, w);
+    HNN_TASKS_CHECK(w <= kMaxAdamWidth || fit.samples(),
+                    "--hidden {} is wider than Adam trains ({} at most); --fit sampled takes up "
+                    "to {}",
+                    w, kMaxAdamWidth, kMaxWidth);
   }
 }
 
-TrainConfig train_config(const Task& task, const RunOptions& o) {
+TrainConfig train_config(const Task& task, const RunOptions& o, const FitConfig& fit) {
   TrainConfig c = task.train_config();
   if (o.preset == Preset::kLean) c.hidden = task.lean_hidden();
+  if (!fit.steps()) c.steps = 0;  // a sampled fit takes none: its runs record so
   if (o.steps) c.steps = *o.steps;
   if (o.batch_size) c.batch_size = *o.batch_size;
   if (o.hidden) c.hidden = *o.hidden;
@@ -129,6 +135,7 @@ json run_metrics(const TaskRun& run, const RunFolder& folder, const TrainResult&
                  const RunSettings& settings) {
   json metrics = run.evaluate(&folder);
   metrics["train_seconds"] = trained.seconds;
+  if (!trained.fit.is_null()) metrics["fit"] = trained.fit;
   metrics["final_batch_loss"] =
       number(trained.curve.empty() ? NAN : trained.curve.back().train_loss);
   metrics.update(settings.to_json());
@@ -183,24 +190,32 @@ RunSettings resolve(const Task& task, const RunOptions& o) {
                             nn::to_string(o.model), fmt::join(names, ", "),
                             needs_velocities_note(o.model)));
   }
+  const FitConfig fit = fit_config(o.task_settings, task.name());
+  check_fit_model(fit, o.model, task.name());
   RunSettings s{.task = task.name(),
                 .model = o.model,
                 .seed = o.seed,
                 .dtype = o.dtype,
                 .preset = o.preset,
                 .threads = o.threads,
-                .train = train_config(task, o),
+                .train = train_config(task, o, fit),
                 .data_file = o.data_file,
                 .data_sha256 = o.data_sha256,
                 .continued_from = o.continued_from,
                 .task_settings = o.task_settings,
-                .loss = rollout_loss_config(o.task_settings, task.name())};
-  check_train_config(s.train);
+                .loss = rollout_loss_config(o.task_settings, task.name()),
+                .fit = fit};
+  check_train_config(s.train, s.fit);
+  HNN_TASKS_CHECK(!s.loss.rollout || s.fit.steps(),
+                  "{}: --loss rollout does not apply to --fit sampled (the last layer is solved "
+                  "on dx/dt targets; --fit sampled+adam fine-tunes through the integrator)",
+                  task.name());
   return s;
 }
 
 RunSettings validate(const RunOptions& o) {
   const RunSettings s = resolve(*make_task(o.task), o);
+  if (!s.fit.steps()) check_sampled_options(o);
   HNN_TASKS_CHECK(!o.checkpoint_every || *o.checkpoint_every > 0,
                   "--checkpoint-every must be positive, got {}", o.checkpoint_every.value_or(0));
   HNN_TASKS_CHECK(!o.out.empty(), "an output folder is required");
@@ -223,19 +238,26 @@ json run_training(const RunOptions& o) {
   const double data_seconds = seconds_since(start);
   record_data_file(settings);
   const RunFolder folder(o.out);
-  // After the data: bad data leave the folder as it was, or no folder.
+  const json sampled_before = o.resume ? recorded_fit(o.out) : json();  // not sampled again
+  // --fit sampled writes nothing while it runs: a fit that fails leaves the folder as it was.
+  const bool sampled_only = !settings.fit.steps();
+  TrainResult trained;
+  if (sampled_only) trained = run->train(loop_options(o, settings, folder));
+  // After the data (and a sampled fit): bad data leave the folder as it was, or no folder.
   if (o.force && !o.resume && fs::is_directory(o.out)) {
     for (const fs::directory_entry& entry : fs::directory_iterator(o.out))
       fs::remove_all(entry.path());
   }
   folder.create();
-  const TrainResult trained = run->train(loop_options(o, settings, folder));
+  if (!sampled_only) trained = run->train(loop_options(o, settings, folder));
+  if (trained.fit.is_null()) trained.fit = sampled_before;
   run->save(folder.params_file());
   json metrics = run_metrics(*run, folder, trained, settings);
   // A run that learns in standardised units (a data run) watched its loss in them: the columns
-  // say so, as metrics.json's keys do.
-  folder.write_loss_curve(trained.curve,
-                          metrics.contains("test_loss_standardised") ? "_standardised" : "");
+  // say so, as metrics.json's keys do. A pure sampled fit takes no steps and has no curve.
+  if (settings.fit.steps())
+    folder.write_loss_curve(trained.curve,
+                            metrics.contains("test_loss_standardised") ? "_standardised" : "");
   metrics["data_seconds"] = data_seconds;
   folder.write_metrics(metrics);
   return metrics;
@@ -270,6 +292,8 @@ json evaluate_run(const fs::path& run_dir, const std::string& data_file, bool wr
   const RunFolder folder(run_dir);
   json metrics = loaded.run->evaluate(write_files ? &folder : nullptr);
   metrics.update(loaded.settings.to_json());
+  // How the weights were fitted, as trained: the summary says so beside the new figures.
+  if (json fit = recorded_fit(run_dir); !fit.is_null()) metrics["fit"] = std::move(fit);
   metrics["warnings"] = run_warnings({}, metrics);
   return metrics;
 }
@@ -305,6 +329,7 @@ json reversibility(const fs::path& run_dir, const ReversibilityOptions& options,
 }
 
 RunOptions resume_options(const fs::path& run_dir, std::optional<int> steps) {
+  check_not_sampled_run(run_dir);
   const fs::path dir = RunFolder(run_dir).checkpoint_dir();
   const TrainState state = read_train_state(dir);
   RunOptions o = options_from_json(state.run, fmt::format("the checkpoint in '{}'", dir.string()));

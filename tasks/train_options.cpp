@@ -1,4 +1,5 @@
-// The table of `hnn train`'s options (train_options.h) and apply(), where each lands.
+// The table of `hnn train`'s options (train_options.h); apply(), where each lands, is in
+// train_options_apply.cpp.
 
 #include "tasks/train_options.h"
 
@@ -21,6 +22,8 @@ constexpr long long kIntMax = std::numeric_limits<int>::max();
 constexpr std::string_view kDataGroup = "The data task (hnn train data --data FILE)";
 constexpr std::string_view kRolloutGroup =
     "Training through an integrator (every task that learns a field)";
+constexpr std::string_view kFitGroup =
+    "Training without backpropagation (every task that learns a field)";
 
 std::vector<std::string> split_names() { return nn::names_of(kSplitByNames); }
 
@@ -285,6 +288,72 @@ const TrainOption kOptions[] = {
      .sweep_rank = 25,
      .applies_to = AppliesTo::kFieldTasks,
      .key = "dt"},
+    {.name = "fit",
+     .kind = ValueKind::kChoice,
+     .help = "adam, sampled (hidden layers sampled from the data, the last layer by least "
+             "squares: no steps) or sampled+adam (sampled, then every weight fine-tuned by Adam "
+             "for --steps) (default adam)",
+     .group = kFitGroup,
+     .sweep_rank = 26,
+     .applies_to = AppliesTo::kFieldTasks,
+     .key = "fit",
+     .choices = fit_method_names,
+     .noun = "fit method"},
+    {.name = "sampler",
+     .kind = ValueKind::kChoice,
+     .help = "How a sampled fit draws hidden weights: elm (at random), uswim (each neuron from a "
+             "pair of data points) or aswim (pairs weighted by how fast dx/dt changes) (default "
+             "uswim)",
+     .group = kFitGroup,
+     .sweep_rank = 27,
+     .applies_to = AppliesTo::kFieldTasks,
+     .key = "sampler",
+     .choices = sampler_names,
+     .noun = "sampler"},
+    {.name = "rcond",
+     .kind = ValueKind::kFraction,
+     .help = "The least-squares cutoff: singular values below rcond times the largest do not "
+             "shape the last layer, in (0, 1) (default 1e-13)",
+     .group = kFitGroup,
+     .sweep_rank = 28,
+     .applies_to = AppliesTo::kFieldTasks,
+     .key = "rcond"},
+    {.name = "solver",
+     .kind = ValueKind::kChoice,
+     .help = "The last layer's least-squares solver: lsqr (preconditioned iterations), cholesky "
+             "(regularised normal equations) or qr (LAPACK's dgelsd, like numpy's lstsq) (default "
+             "lsqr)",
+     .group = kFitGroup,
+     .sweep_rank = 29,
+     .applies_to = AppliesTo::kFieldTasks,
+     .key = "solver",
+     .choices = solver_names,
+     .noun = "solver"},
+    {.name = "regularization",
+     .kind = ValueKind::kPositiveReal,
+     .help = "lambda added to the diagonal of A^T A (columns scaled to unit norm) by cholesky and "
+             "lsqr's preconditioner, raised tenfold while the factorisation fails (default 1e-13)",
+     .group = kFitGroup,
+     .sweep_rank = 30,
+     .applies_to = AppliesTo::kFieldTasks,
+     .key = "regularization"},
+    {.name = "solver-tolerance",
+     .kind = ValueKind::kFraction,
+     .help = "lsqr stops when |A^T r| < this * |A| |r|, in (0, 1) (default 1e-14)",
+     .group = kFitGroup,
+     .sweep_rank = 31,
+     .applies_to = AppliesTo::kFieldTasks,
+     .key = "solver_tolerance"},
+    {.name = "solver-iterations",
+     .kind = ValueKind::kInt,
+     .help = "lsqr's iteration cap, 1 to 100000 (default 200)",
+     .group = kFitGroup,
+     .sweep_rank = 32,
+     .applies_to = AppliesTo::kFieldTasks,
+     .key = "solver_iterations",
+     .min = 1,
+     .max = 100000,
+     .range_in_help = true},
 };
 
 }  // namespace
@@ -303,76 +372,6 @@ std::vector<std::string> lr_schedule_names() { return nn::names_of(kLrScheduleNa
 std::string not_applicable(const TrainOption& option, const std::string& task) {
   if (option.applies_to != AppliesTo::kDataTask || task == "data") return "";
   return fmt::format("applies to the data task only, not to '{}'", task);
-}
-
-void apply(const TrainOption& option, const json& v, RunOptions& o) {
-  switch (option.lands) {
-    case Lands::kTask:
-      o.task = v.get<std::string>();
-      return;
-    case Lands::kModel:
-      o.model = parse_model(v.get<std::string>());
-      return;
-    case Lands::kSeed:
-      o.seed = v.get<std::uint64_t>();
-      return;
-    case Lands::kDtype:
-      o.dtype = parse_dtype(v.get<std::string>());
-      return;
-    case Lands::kPreset:
-      o.preset = parse_preset(v.get<std::string>());
-      return;
-    case Lands::kThreads:
-      o.threads = v.get<int>();
-      return;
-    case Lands::kSteps:
-      o.steps = v.get<int>();
-      return;
-    case Lands::kBatchSize:
-      o.batch_size = v.get<int>();
-      return;
-    case Lands::kHidden:
-      o.hidden = v.get<std::vector<int>>();
-      return;
-    case Lands::kLearningRate:
-      o.learning_rate = v.get<double>();
-      return;
-    case Lands::kLrSchedule:
-      o.lr_schedule = parse_lr_schedule(v.get<std::string>());
-      return;
-    case Lands::kDataFile:
-      o.data_file = v.get<std::string>();
-      return;
-    case Lands::kOut:
-      o.out = v.get<std::string>();
-      return;
-    case Lands::kQuiet:
-      o.quiet = v.get<bool>();
-      return;
-    case Lands::kPrintJson:
-      o.print_json = v.get<bool>();
-      return;
-    case Lands::kTaskSettings: {
-      // The keys already set by their own options stay (the data task's, the rollout loss's).
-      json settings = v;
-      if (settings.is_object()) settings.update(o.task_settings);
-      o.task_settings = std::move(settings);
-      return;
-    }
-    case Lands::kCheckpointEvery:
-      o.checkpoint_every = v.get<long>();
-      return;
-    case Lands::kResume:
-      o.out = v.get<std::string>();
-      o.resume = true;
-      return;
-    case Lands::kForce:
-      o.force = v.get<bool>();
-      return;
-    case Lands::kTaskSetting:
-      o.task_settings[std::string(option.key)] = v;
-      return;
-  }
 }
 
 }  // namespace hnn::tasks

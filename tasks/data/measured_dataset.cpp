@@ -20,7 +20,8 @@ struct Parts {
 Segment slice(const Segment& s, Eigen::Index begin, Eigen::Index end) {
   const Eigen::Index n = end - begin;
   return {s.trajectory, std::vector<Eigen::Index>(s.rows.begin() + begin, s.rows.begin() + end),
-          s.t.segment(begin, n), s.x.middleRows(begin, n), s.dxdt.middleRows(begin, n)};
+          s.t.size() > 0 ? Eigen::VectorXd(s.t.segment(begin, n)) : Eigen::VectorXd(),  // scattered
+          s.x.middleRows(begin, n), s.dxdt.middleRows(begin, n)};
 }
 
 // round(fraction * n), at least 1 and at most n - 1.
@@ -88,16 +89,34 @@ int distinct_trajectories(const std::vector<Segment>& parts) {
   return int(ids.size());
 }
 
+// Scattered states: the file's last rows are the test set.
+Parts split_by_rows(const MeasuredTrajectories& m, const SplitChoice& split) {
+  HNN_TASKS_CHECK(split.by == SplitBy::kAuto,
+                  "{}: split by {} needs trajectories, and the file holds scattered states (no "
+                  "time column): leave the split at auto (the last rows are the test set)",
+                  m.table.source, split.by == SplitBy::kTime ? "time" : "trajectories");
+  const Segment& all = m.segments.at(0);
+  const auto n = Eigen::Index(all.rows.size());
+  HNN_TASKS_CHECK(n >= 2,
+                  "{}: {} row{} of scattered states: at least 2 are needed (one to train, "
+                  "one to test)",
+                  m.table.source, n, n == 1 ? "" : "s");
+  const Eigen::Index cut = n - test_count(split.test_fraction, n);
+  return {{slice(all, 0, cut)}, {slice(all, cut, n)}};
+}
+
 }  // namespace
 
 MeasuredData split_trajectories(const MeasuredTrajectories& m, const SplitChoice& split) {
   HNN_TASKS_CHECK(split.test_fraction > 0 && split.test_fraction < 1,
                   "test fraction {} is not between 0 and 1", split.test_fraction);
   MeasuredData out;
+  out.scattered = m.scattered;
   out.split = split.by != SplitBy::kAuto    ? split.by
               : m.trajectory_ids.size() > 1 ? SplitBy::kTrajectories
                                             : SplitBy::kTime;
-  const Parts parts = out.split == SplitBy::kTrajectories
+  const Parts parts = m.scattered ? split_by_rows(m, split)
+                      : out.split == SplitBy::kTrajectories
                           ? split_by_trajectories(m, split.test_fraction)
                           : split_by_time(m, split.test_fraction);
   out.data = {stack(parts.train, &Segment::x), stack(parts.train, &Segment::dxdt),
@@ -118,7 +137,7 @@ MeasuredData split_trajectories(const MeasuredTrajectories& m, const SplitChoice
   out.derivative_names = m.derivative_names;
   out.derivatives_note = m.derivatives_note;
   out.trajectories = int(m.trajectory_ids.size());
-  out.test_trajectories = distinct_trajectories(parts.test);
+  out.test_trajectories = m.scattered ? 0 : distinct_trajectories(parts.test);
   out.gaps = m.gaps;
   out.dropped_rows = m.dropped_rows;
   return out;
@@ -133,11 +152,21 @@ std::string describe(const MeasuredData& d) {
     return fmt::format(
         "{}", fmt::join(d.state_names.begin() + from, d.state_names.begin() + from + count, ", "));
   };
-  std::string text =
-      fmt::format("{}: {} trajector{}; coordinates {}; {} {}{}\n", d.source, d.trajectories,
-                  d.trajectories == 1 ? "y" : "ies", names(0, d.coordinates),
-                  d.velocities ? "velocities" : "momenta", names(d.coordinates, d.coordinates),
-                  d.velocities ? " (velocities taken as momenta: unit masses assumed)" : "");
+  std::string text = fmt::format(
+      "{}: {}; coordinates {}; {} {}{}\n", d.source,
+      d.scattered
+          ? "scattered states (no time column)"
+          : fmt::format("{} trajector{}", d.trajectories, d.trajectories == 1 ? "y" : "ies"),
+      names(0, d.coordinates), d.velocities ? "velocities" : "momenta",
+      names(d.coordinates, d.coordinates),
+      d.velocities ? " (velocities taken as momenta: unit masses assumed)" : "");
+  if (d.scattered) {
+    return text + fmt::format(
+                      "dx/dt from the file's derivative columns ({})\nsplit by rows: {} "
+                      "training rows, {} test rows (the file's last)",
+                      fmt::join(d.derivative_names, ", "), d.data.train_x.rows(),
+                      d.data.test_x.rows());
+  }
   text += d.derivatives_given ? "dx/dt from the file's derivative columns"
                               : "dx/dt by finite differences within each trajectory";
   if (d.derivatives_by_name)

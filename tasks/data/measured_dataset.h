@@ -53,13 +53,17 @@ struct MeasuredData {
   std::vector<std::string> derivative_names;  ///< the columns of dx/dt, when given
   std::string derivatives_note;               ///< some derivative columns found, not all
   SplitBy split = SplitBy::kTime;             ///< the split made (never kAuto)
+  /// Scattered states (no time column): split by rows, the file's last are the test set; no
+  /// trajectories, no held-out or training stretches.
+  bool scattered = false;
   int trajectories = 0, test_trajectories = 0, gaps = 0;
   Eigen::Index dropped_rows = 0;
 };
 
 /// Splits by whole trajectories (the last round(fraction * n) of them, at least one on each
 /// side) or by time (the last round(fraction * m) rows of each trajectory of m rows, at least
-/// one on each side). dx/dt were computed before the split, so the rows next to the cut use
+/// one on each side); scattered states by rows (the last round(fraction * m) of the file's m,
+/// with split auto only). dx/dt were computed before the split, so the rows next to the cut use
 /// their neighbours across it. Throws tasks::Error on a fraction outside (0, 1) or a split by
 /// trajectories of a file with one.
 MeasuredData split_trajectories(const MeasuredTrajectories& trajectories, const SplitChoice& split);

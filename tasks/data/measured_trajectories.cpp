@@ -139,14 +139,26 @@ std::vector<Eigen::Index> find_derivatives(const Table& table, const Columns& c,
   return {};
 }
 
+// Without a time column the rows are scattered states, which need their dx/dt from columns
+// and cannot have trajectories.
+void check_scattered(const Table& table, const Columns& c, const std::string& note) {
+  HNN_TASKS_CHECK(!c.derivatives.empty(),
+                  "{}: no time column (none is named t, time or times) and no derivative columns"
+                  "{}: give the time column by name or index, or for scattered states dx/dt of "
+                  "every state column (named d<x>/dt, or chosen with --derivatives) (columns: {})",
+                  table.source, note.empty() ? "" : " (" + note + ")",
+                  fmt::join(table.names, ", "));
+  HNN_TASKS_CHECK(c.trajectory < 0,
+                  "{}: a trajectory column ('{}') but no time column (none is named t, time or "
+                  "times): give the time column, or drop the trajectory column for scattered "
+                  "states",
+                  table.source, table.names[std::size_t(c.trajectory)]);
+}
+
 Columns resolve_columns(const Table& table, const ColumnChoice& choice, std::string& note) {
   Columns c;
   c.time = choice.time.empty() ? first_present(table, {"t", "time", "times"})
                                : table.column(choice.time);
-  HNN_TASKS_CHECK(c.time >= 0,
-                  "{}: no time column (none is named t, time or times): give it by name or index "
-                  "(columns: {})",
-                  table.source, fmt::join(table.names, ", "));
   c.trajectory = choice.trajectory.empty() ? first_present(table, {"trajectory", "trial"})
                                            : table.column(choice.trajectory);
   resolve_state(table, choice, c);
@@ -161,6 +173,7 @@ Columns resolve_columns(const Table& table, const ColumnChoice& choice, std::str
                   table.source, c.derivatives.size(), names_of(table, c.derivatives),
                   2 * c.coords.size(), c.velocities ? "velocity" : "momentum");
   check_distinct(table, c);
+  if (c.time < 0) check_scattered(table, c, note);
   return c;
 }
 
@@ -219,11 +232,21 @@ Segment make_segment(const Table& table, const Columns& c, double id,
                                                                             Eigen::Index(v.size()));
   };
   Segment s{id, std::move(rows), {}, {}, {}};
-  s.t = table.values(idx(s.rows), c.time);
+  if (c.time >= 0) s.t = table.values(idx(s.rows), c.time);
   s.x = table.values(idx(s.rows), idx(state));
   s.dxdt = c.derivatives.empty() ? finite_differences(s.t, s.x)
                                  : Batch(table.values(idx(s.rows), idx(c.derivatives)));
   return s;
+}
+
+// A file without a time column: its rows as one segment of states with no times.
+MeasuredTrajectories scattered_states(Table table, const Columns& c, MeasuredTrajectories out) {
+  std::vector<Eigen::Index> rows(std::size_t(table.rows()));
+  for (Eigen::Index i = 0; i < table.rows(); ++i) rows[std::size_t(i)] = i;
+  out.scattered = true;
+  out.segments.push_back(make_segment(table, c, 0.0, std::move(rows)));
+  out.table = std::move(table);
+  return out;
 }
 
 // The three Lagrange weights of the derivative at `at` through the points a, b, c.
@@ -263,6 +286,7 @@ MeasuredTrajectories select_trajectories(Table table, const ColumnChoice& choice
   out.derivatives_given = !c.derivatives.empty();
   for (Eigen::Index j : c.derivatives) out.derivative_names.push_back(table.names[std::size_t(j)]);
   out.derivatives_by_name = out.derivatives_given && choice.derivatives.empty();
+  if (c.time < 0) return scattered_states(std::move(table), c, std::move(out));
   out.time_name = table.names[std::size_t(c.time)];
   if (c.trajectory >= 0) out.trajectory_name = table.names[std::size_t(c.trajectory)];
   for (auto& [id, rows] : group_rows(table, c.trajectory)) {

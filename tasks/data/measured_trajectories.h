@@ -53,19 +53,25 @@ struct MeasuredTrajectories {
   bool derivatives_by_name = false;           ///< those columns found by their names
   std::vector<std::string> derivative_names;  ///< the columns of dx/dt, when given
   std::string derivatives_note;               ///< some derivative columns found but not all, or ""
-  std::string time_name, trajectory_name;     ///< trajectory_name is "" when there is none
-  std::vector<double> trajectory_ids;         ///< in order of first appearance
-  std::vector<Segment> segments;              ///< by trajectory (that order), then time
-  int gaps = 0;                               ///< cuts made at gaps in time
+  /// No time column: the rows are scattered states with their given dx/dt, in one segment
+  /// without times; no trajectories.
+  bool scattered = false;
+  std::string time_name, trajectory_name;  ///< trajectory_name is "" when there is none
+  std::vector<double> trajectory_ids;      ///< in order of first appearance
+  std::vector<Segment> segments;           ///< by trajectory (that order), then time
+  int gaps = 0;                            ///< cuts made at gaps in time
   /// Rows left out: stretches between gaps too short (< 3 points) to difference.
   Eigen::Index dropped_rows = 0;
 };
 
 /// Picks the columns, groups rows by trajectory id (rows of one id in file order), cuts at gaps
-/// and computes dx/dt. Throws tasks::Error naming the file (and line or row) on a missing,
-/// repeated or doubly chosen column, coordinates and momenta of different counts, derivative
-/// columns not one per state column, a trajectory of fewer than 3 points, time not increasing
-/// within a trajectory, or nothing left to difference.
+/// and computes dx/dt. A file without a time column whose derivative columns are given (by name
+/// or chosen) holds scattered states (MeasuredTrajectories::scattered). Throws tasks::Error
+/// naming the file (and line or row) on a missing, repeated or doubly chosen column,
+/// coordinates and momenta of different counts, derivative columns not one per state column,
+/// no time column without derivative columns (or with a trajectory column), a trajectory of
+/// fewer than 3 points, time not increasing within a trajectory, or nothing left to
+/// difference.
 MeasuredTrajectories select_trajectories(Table table, const ColumnChoice& choice);
 
 /// dx/dt at each of the times t (increasing, at least 3, possibly unevenly spaced) from the

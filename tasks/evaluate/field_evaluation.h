@@ -42,13 +42,26 @@ double dissipation_share(const nn::DynamicsModel<double>& model, const Batch& x,
 /// (asked for), "n_rollouts" (that did not fail), "rollout_t_end" and "rollout_failures".
 nlohmann::json rollout_metrics(const Rollouts& rollouts, double threshold = 0.1);
 
-/// Evaluates `model` on `data` and on rollouts from `x0` against `truth`.
+/// Evaluates `model` on `data` and on rollouts from `x0` against `truth`, with the error of the
+/// learned H on the test states (hamiltonian_rel_l2, tasks/evaluate/hamiltonian_error.h).
 FieldEvaluation evaluate_field_model(const physics::System& truth,
                                      const nn::DynamicsModel<double>& model, const Dataset& data,
                                      const Batch& x0, const RolloutConfig& config);
 /// The same with rollouts made already (along measured paths, say).
 FieldEvaluation evaluate_field_model(const nn::DynamicsModel<double>& model, const Dataset& data,
                                      Rollouts rollouts);
+
+/// metrics.json's "rollouts_skipped" for scattered states: why a run has no rollout keys.
+inline constexpr const char* kRolloutsSkipped =
+    "scattered states with exact derivatives, no trajectories: no rollouts, valid prediction "
+    "time or reversibility; the run is judged on the held-out points (test_loss, test_r2, and "
+    "hamiltonian_rel_l2 where the true H is known)";
+
+/// Evaluates `model` on scattered states (no trajectories): the losses, counts and R^2 of both
+/// splits, and with a truth (may be null) hamiltonian_rel_l2 on the test states
+/// (tasks/evaluate/hamiltonian_error.h); no rollouts, and "rollouts_skipped" says so.
+FieldEvaluation evaluate_field_points(const physics::System* truth,
+                                      const nn::DynamicsModel<double>& model, const Dataset& data);
 
 /// rollout.csv (tasks/report/rollout_csv.h): per trajectory the truth ("true", or "data" when
 /// measured) and the model's prediction (source `model_name`).

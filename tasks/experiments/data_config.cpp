@@ -9,6 +9,7 @@
 #include "nn/enum_names.h"
 #include "tasks/error.h"
 #include "tasks/field/rollout_settings.h"
+#include "tasks/train/fit_method.h"
 
 namespace hnn::tasks {
 
@@ -38,7 +39,12 @@ const std::vector<std::string>& data_setting_names() {
       "split",           "test_fraction", "gap_factor", "hamiltonian", "standardize", "threshold",
       "rollouts",        "t_end",         "loss",       "horizon",     "integrator",  "dt",
       "energy_rollouts", "energy_t_end"};
-  return names;
+  static const std::vector<std::string> with_fit = [] {
+    std::vector<std::string> all = names;
+    all.insert(all.end(), fit_setting_names().begin(), fit_setting_names().end());
+    return all;
+  }();
+  return with_fit;
 }
 
 DataConfig data_config(const json& s) {
@@ -75,6 +81,21 @@ DataConfig data_config(const json& s) {
   c.rollouts = r.trajectories;
   if (s.contains("t_end") || s.contains("energy_t_end")) c.t_end = r.t_end;
   return c;
+}
+
+void check_scattered_settings(const json& settings, const RolloutLossConfig& loss,
+                              const std::string& source) {
+  HNN_TASKS_CHECK(!loss.rollout,
+                  "{}: the rollout loss needs trajectories, and the file holds scattered states "
+                  "(no time column): use --loss derivative",
+                  source);
+  for (const char* key :
+       {"rollouts", "t_end", "energy_rollouts", "energy_t_end", "threshold", "gap_factor"}) {
+    HNN_TASKS_CHECK(!settings.contains(key),
+                    "{}: the setting {} needs trajectories, and the file holds scattered states "
+                    "(no time column): leave it out",
+                    source, key);
+  }
 }
 
 }  // namespace hnn::tasks

@@ -7,6 +7,7 @@
 
 #include "tasks/data/measured_dataset.h"
 #include "tasks/evaluate/rollouts.h"
+#include "tasks/options.h"
 
 namespace hnn::tasks {
 
@@ -28,5 +29,10 @@ const std::vector<std::string>& data_setting_names();
 
 /// The settings of a data run; a bad value is an Error naming it.
 DataConfig data_config(const nlohmann::json& settings);
+
+/// For a file of scattered states (`source`, no time column): throws Error naming what needs
+/// trajectories, the rollout loss or a setting of the rollouts or of gaps in time.
+void check_scattered_settings(const nlohmann::json& settings, const RolloutLossConfig& loss,
+                              const std::string& source);
 
 }  // namespace hnn::tasks

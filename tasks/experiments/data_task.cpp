@@ -11,6 +11,7 @@
 #include "physics/integrator.h"
 #include "tasks/data/units.h"
 #include "tasks/evaluate/field_evaluation.h"
+#include "tasks/evaluate/hamiltonian_error.h"
 #include "tasks/evaluate/held_out.h"
 #include "tasks/experiments/data_config.h"
 #include "tasks/experiments/registry.h"
@@ -89,6 +90,7 @@ Prepared prepare(const RunSettings& s) {
                 ? fit_units(p.measured.data, p.measured.coordinates, p.measured.state_names)
                 : identity_units(p.measured.data.train_x.cols());
   p.truth = make_truth(p.config.hamiltonian, p.measured);
+  if (p.measured.scattered) check_scattered_settings(s.task_settings, s.loss, p.measured.source);
   return p;
 }
 
@@ -147,22 +149,30 @@ class DataRun : public FieldModelRun {
               {"n_train", d.train_x.rows()},
               {"n_test", d.test_x.rows()}};
     m.update(standardised_losses(model, data_));
-    const HeldOutEvaluation held = evaluate_held_out(
-        model, p_.units, p_.measured.held_out, p_.measured.coordinates, data_.train_x,
-        {.threshold = p_.config.threshold, .truth = p_.truth.get()});
-    m.update(held.metrics);
     if (dynamics().config().field == nn::FieldType::kBoth) {
       m["dissipation_share"] = number(dissipation_share(
           dynamics(), data_.test_x, [&](const Batch& f) { return p_.units.rate_to_file(f); }));
     }
-    m.update(energy_metrics(file));
+    if (p_.truth) m.update(hamiltonian_error_metrics(*p_.truth, file, d.test_x));
+    const bool scattered = p_.measured.scattered;
+    HeldOutEvaluation held;
+    if (scattered) m["rollouts_skipped"] = kRolloutsSkipped;
+    if (!scattered) {
+      held = evaluate_held_out(model, p_.units, p_.measured.held_out, p_.measured.coordinates,
+                               data_.train_x,
+                               {.threshold = p_.config.threshold, .truth = p_.truth.get()});
+      m.update(held.metrics);
+      m.update(energy_metrics(file));
+    }
     m["training"] = s_.loss.to_json();
     m["units"] = units_statement(p_.units);
     m["state_names"] = p_.measured.state_names;
     m["data"] = describe(p_.measured);
     if (folder) {
-      folder->write_text("rollout.csv",
-                         held_out_csv(held, p_.measured.state_names, nn::to_string(s_.model)));
+      if (!scattered) {
+        folder->write_text("rollout.csv",
+                           held_out_csv(held, p_.measured.state_names, nn::to_string(s_.model)));
+      }
       // Said once the run has gone through: an error before it stays the one line on stderr.
       fmt::print(stderr, "hnn: data: {}\n", derivatives_source(p_.measured));
     }
@@ -175,19 +185,26 @@ class DataRun : public FieldModelRun {
   // so when the span goes past them.
   RolloutOutput rollout(const RolloutRequest& r) const override {
     const std::vector<double> t =
-        physics::linspace(0.0, r.t_end.value_or(rollout_span() * p_.units.time), r.points);
+        physics::linspace(0.0, r.t_end ? *r.t_end : rollout_span() * p_.units.time, r.points);
     const auto integrator =
         physics::make_integrator(r.integrator, {.dt = r.dt, .rtol = r.rtol, .atol = r.rtol * 1e-3});
     RolloutCsv csv(p_.measured.state_names, {.times = 12});
     RolloutOutput out;
-    const bool given = r.initial_states.rows() > 0;
+    // Scattered states have no held-out stretches: their test states start the paths.
+    const Batch& tests = p_.measured.data.test_x;
+    const Batch starts =
+        r.initial_states.rows() > 0 ? r.initial_states
+        : p_.measured.scattered
+            ? spread_rows(tests, trajectories_to_write(r, int(tests.rows()), "test states"))
+            : Batch();
+    const bool given = starts.rows() > 0;
     const auto& held = p_.measured.held_out;
-    out.trajectories = given ? int(r.initial_states.rows())
+    out.trajectories = given ? int(starts.rows())
                              : trajectories_to_write(r, int(held.size()), "held-out stretches");
     double data_end = INFINITY;
     for (int i = 0; i < out.trajectories; ++i) {
       const auto k = std::size_t(i);
-      const Batch x0 = given ? Batch(r.initial_states.row(i)) : Batch(held[k].x.topRows(1));
+      const Batch x0 = given ? Batch(starts.row(i)) : Batch(held[k].x.topRows(1));
       if (!given) {
         csv.add(kDataSource, k, held[k].t.array() - held[k].t(0), held[k].x, energy(held[k].x));
         data_end = std::min(data_end, held[k].t(held[k].t.size() - 1) - held[k].t(0));
@@ -246,7 +263,13 @@ class DataRun : public FieldModelRun {
   Batch rollout_states(int count) const override { return spread_rows(data_.test_x, count); }
 
   // The held-out stretches' median duration, in the model's time unit.
-  double rollout_span() const override { return held_out_duration() / p_.units.time; }
+  double rollout_span() const override {
+    HNN_TASKS_CHECK(!p_.measured.scattered,
+                    "{}: scattered states (no time column) have no time span to roll out over: "
+                    "give one with --t-end",
+                    p_.measured.source);
+    return held_out_duration() / p_.units.time;
+  }
 
  private:
   // The note of a run without an H whose rollouts leave the data (or start from given states).

@@ -19,6 +19,9 @@ const std::vector<std::pair<std::string, Factory>>& registry() {
       {"damped-spring", make_damped_spring_task},
       {"double-pendulum", make_double_pendulum_task},
       {"real-double-pendulum", make_real_double_pendulum_task},
+      {"henon-heiles", make_henon_heiles_task},
+      {"pendulum-scattered", make_pendulum_scattered_task},
+      {"double-pendulum-scattered", make_double_pendulum_scattered_task},
       {"data", make_data_task}};
   return tasks;
 }

@@ -15,7 +15,9 @@ namespace hnn::tasks {
 
 /// The tasks by name: spring, pendulum, real-pendulum, two-body, three-body, pixel-pendulum (the
 /// paper's), damped-spring (the dissipative-HNN paper's), double-pendulum (the LNN paper's),
-/// real-double-pendulum (measured) and data (a user's own file). Throws Error naming the known
+/// real-double-pendulum (measured), henon-heiles, pendulum-scattered and
+/// double-pendulum-scattered (the sampled-HNN paper's protocols: scattered states) and data (a
+/// user's own file). Throws Error naming the known
 /// tasks for any other name.
 std::unique_ptr<Task> make_task(const std::string& name);
 std::vector<std::string> task_names();
@@ -28,15 +30,18 @@ std::unique_ptr<FieldTask> make_field_task(const std::string& name);
 Dataset build_dataset(const std::string& task, std::uint64_t seed);
 
 // The experiments' factories, one file each, listed by the registry (registry.cpp).
-std::unique_ptr<Task> make_spring_task();                // spring.cpp
-std::unique_ptr<Task> make_pendulum_task();              // pendulum.cpp
-std::unique_ptr<Task> make_real_pendulum_task();         // real_pendulum.cpp
-std::unique_ptr<Task> make_two_body_task();              // nbody.cpp
-std::unique_ptr<Task> make_three_body_task();            // nbody.cpp
-std::unique_ptr<Task> make_pixel_pendulum_task();        // pixel_pendulum.cpp
-std::unique_ptr<Task> make_damped_spring_task();         // damped_spring.cpp
-std::unique_ptr<Task> make_double_pendulum_task();       // double_pendulum.cpp
-std::unique_ptr<Task> make_real_double_pendulum_task();  // real_double_pendulum.cpp
-std::unique_ptr<Task> make_data_task();                  // data_task.cpp
+std::unique_ptr<Task> make_spring_task();                     // spring.cpp
+std::unique_ptr<Task> make_pendulum_task();                   // pendulum.cpp
+std::unique_ptr<Task> make_real_pendulum_task();              // real_pendulum.cpp
+std::unique_ptr<Task> make_two_body_task();                   // nbody.cpp
+std::unique_ptr<Task> make_three_body_task();                 // nbody.cpp
+std::unique_ptr<Task> make_pixel_pendulum_task();             // pixel_pendulum.cpp
+std::unique_ptr<Task> make_damped_spring_task();              // damped_spring.cpp
+std::unique_ptr<Task> make_double_pendulum_task();            // double_pendulum.cpp
+std::unique_ptr<Task> make_real_double_pendulum_task();       // real_double_pendulum.cpp
+std::unique_ptr<Task> make_henon_heiles_task();               // scattered.cpp
+std::unique_ptr<Task> make_pendulum_scattered_task();         // scattered.cpp
+std::unique_ptr<Task> make_double_pendulum_scattered_task();  // scattered.cpp
+std::unique_ptr<Task> make_data_task();                       // data_task.cpp
 
 }  // namespace hnn::tasks

@@ -28,7 +28,8 @@ class FieldRun : public FieldModelRun {
   FieldRun(const FieldTask& task, RunSettings settings)
       : FieldModelRun(settings, task.build_dataset(settings),
                       {.angles = task.angle_coordinates(), .input_scale = task.input_scale()}),
-        task_(task) {
+        task_(task),
+        own_truth_(task.truth_for(s_)) {
     const RolloutLossConfig& loss = s_.loss;
     check_rollouts();
     stretches_ = task_.stretches(s_, data_);
@@ -36,12 +37,17 @@ class FieldRun : public FieldModelRun {
   }
 
   nlohmann::json evaluate(const RunFolder* folder) const override {
+    if (task_.scattered()) {
+      json m = evaluate_field_points(&truth(), dynamics(), data_).metrics;
+      m["training"] = training_.loss().to_json();
+      return m;
+    }
     const auto start = std::chrono::steady_clock::now();
     const RolloutConfig config = evaluation_rollouts();
     FieldEvaluation e =
         task_.has_truth()
-            ? evaluate_field_model(task_.truth(), dynamics(), data_,
-                                   rollout_states(config.trajectories), config)
+            ? evaluate_field_model(truth(), dynamics(), data_, rollout_states(config.trajectories),
+                                   config)
             : evaluate_field_model(
                   dynamics(), data_,
                   follow_measured(measured_paths(config), learned_field(dynamics()), config));
@@ -61,7 +67,7 @@ class FieldRun : public FieldModelRun {
       m.update(held_out_stretch_metrics(dynamics(), *stretches_,
                                         {.per_body = task_.coordinates_per_body(),
                                          .stepping = training_.stepping(),
-                                         .truth = task_.has_truth() ? &task_.truth() : nullptr}));
+                                         .truth = task_.has_truth() ? &truth() : nullptr}));
     }
     return m;
   }
@@ -88,9 +94,9 @@ class FieldRun : public FieldModelRun {
       x0.conservativeResize(trajectories_to_write(r, int(x0.rows()), "distinct test states"),
                             Eigen::NoChange);
     }
-    return {.csv = rollout_paths_csv(task_.truth(), dynamics(), nn::to_string(s_.model), x0,
-                                     *integrator, t),
-            .trajectories = int(x0.rows())};
+    return {
+        .csv = rollout_paths_csv(truth(), dynamics(), nn::to_string(s_.model), x0, *integrator, t),
+        .trajectories = int(x0.rows())};
   }
 
   // The evaluation's states: a generator independent of the training data's draws. Without a
@@ -183,7 +189,11 @@ class FieldRun : public FieldModelRun {
             model.hamiltonian ? model.hamiltonian(x) : Eigen::VectorXd());
   }
 
+  // The run's truth: the task's own, or the one its settings make (FieldTask::truth_for).
+  const physics::System& truth() const { return own_truth_ ? *own_truth_ : task_.truth(); }
+
   const FieldTask& task_;
+  std::unique_ptr<physics::System> own_truth_;
   std::optional<SplitStretches> stretches_;
   int asked_rollouts_ = 0, available_rollouts_ = 0;
 };
@@ -231,6 +241,7 @@ std::optional<SplitStretches> FieldTask::stretches(const RunSettings&, const Dat
 void FieldTask::check_task_settings(const nlohmann::json& settings) const {
   const std::vector<std::string> own = own_setting_names(), rollouts = evaluation_setting_names();
   std::vector<std::string> known = rollout_setting_names();
+  known.insert(known.end(), fit_setting_names().begin(), fit_setting_names().end());
   known.insert(known.end(), own.begin(), own.end());
   known.insert(known.end(), rollouts.begin(), rollouts.end());
   for (const auto& [key, value] : settings.items()) {

@@ -36,6 +36,9 @@ class FieldTask : public Task {
   /// The ground truth for rollouts and energies (a fitted H for measured data). A task without
   /// one (has_truth() false) throws Error.
   virtual const physics::System& truth() const = 0;
+  /// The truth of a run with these settings when they change it (Hénon–Heiles' alpha, say);
+  /// by default none, and the run uses truth().
+  virtual std::unique_ptr<physics::System> truth_for(const RunSettings&) const { return nullptr; }
   /// Whether truth() exists. A task on measured data without a true system says no and gives
   /// measured_paths instead: its rollouts follow held-out measurements.
   virtual bool has_truth() const { return true; }
@@ -43,6 +46,10 @@ class FieldTask : public Task {
   /// truth of follow_measured), for a task without a truth; by default none.
   virtual std::vector<Eigen::MatrixXd> measured_paths(const RunSettings& settings, int count,
                                                       const RolloutConfig& config) const;
+  /// Whether the data are states scattered over a domain with exact derivatives, not
+  /// trajectories (the sampled-HNN paper's protocols): the evaluation judges the held-out points
+  /// alone (evaluate_field_points) and has no rollouts nor their settings. By default no.
+  virtual bool scattered() const { return false; }
   /// Initial states of the evaluation's rollouts: `count` of them, or as many distinct ones as
   /// the task's data have when that is fewer.
   virtual Batch rollout_states(const Dataset& data, int count, std::mt19937_64& rng) const = 0;
@@ -77,7 +84,7 @@ class FieldTask : public Task {
   /// evaluation's (evaluation_setting_names).
   virtual std::vector<std::string> own_setting_names() const { return {}; }
   /// The evaluation's rollouts: "rollouts", "t_end" unless own_setting_names() has it, and
-  /// "rollout_t_end".
+  /// "rollout_t_end"; none for scattered() data.
   std::vector<std::string> evaluation_setting_names() const;
   /// Checks the rollout-loss keys, the rollouts' and own_setting_names(); a task with settings
   /// of its own checks their values in build_dataset (before a run folder exists).

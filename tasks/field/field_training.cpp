@@ -1,7 +1,9 @@
 #include "tasks/field/field_training.h"
 
 #include <algorithm>
+#include <chrono>
 
+#include "nn/sampled/sampled_fit.h"
 #include "tasks/task.h"
 #include "tasks/train/field_objective.h"
 
@@ -39,10 +41,47 @@ FieldTraining::FieldTraining(const RolloutLossConfig& loss, const SplitStretches
                   train.batch_size, train_windows_.count());
 }
 
+namespace {
+
+// Samples the hidden layers of `model` and solves its last layer on the training split's dx/dt:
+// what the fit did, with its wall time, and no loss curve.
+template <typename T>
+TrainResult fit_by_sampling(nn::DynamicsModel<T>& model, const Dataset& data,
+                            const RunSettings& s) {
+  const auto start = std::chrono::steady_clock::now();
+  nn::SampledFitConfig config = s.fit.sampled;
+  config.seed = s.seed;
+  nn::SampledFitReport report;
+  try {
+    report = nn::fit_sampled(model, data.train_x, data.train_dxdt, config);
+  } catch (const std::invalid_argument& e) {
+    throw Error(fmt::format("{}: {}", s.task, e.what()));
+  }
+  return {
+      .seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
+      .fit = fit_report_json(s.fit, report)};
+}
+
+}  // namespace
+
 template <typename T>
 TrainResult FieldTraining::train(nn::DynamicsModel<T>& model, const Dataset& data,
                                  const RunSettings& s, const LoopOptions& loop) const {
-  if (!loss_.rollout) return train_model(model, data, s.train, s.seed, loop);
+  // Resumed, the checkpoint holds the weights: sampled + Adam samples only when it starts.
+  TrainResult sampled;
+  if (s.fit.samples() && !loop.resume) sampled = fit_by_sampling(model, data, s);
+  if (!s.fit.steps()) return sampled;
+  TrainResult trained = loss_.rollout ? train_through_integrator(model, s, loop)
+                                      : train_model(model, data, s.train, s.seed, loop);
+  trained.seconds += sampled.seconds;
+  trained.fit = std::move(sampled.fit);
+  return trained;
+}
+
+template <typename T>
+TrainResult FieldTraining::train_through_integrator(nn::DynamicsModel<T>& model,
+                                                    const RunSettings& s,
+                                                    const LoopOptions& loop) const {
   RolloutObjective<T> objective(model, train_windows_, test_windows_, s.train.batch_size,
                                 {.lr = s.train.learning_rate, .weight_decay = s.train.weight_decay},
                                 s.seed, loss_.integrator, substeps_);

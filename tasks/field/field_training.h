@@ -1,6 +1,8 @@
 #pragma once
 // How a run of a field task trains, chosen in one place: on dx/dt targets (FieldObjective), or
-// from the states alone through an integrator over windows of its stretches (RolloutObjective).
+// from the states alone through an integrator over windows of its stretches (RolloutObjective);
+// either from sampled hidden layers and a solved last layer (--fit sampled+adam), or not at all
+// after them (--fit sampled: nn/sampled/sampled_fit.h).
 // FieldModelRun (field_model_run.h) trains with it; a run says only what differs (its stretches,
 // the time unit of its model).
 
@@ -35,7 +37,9 @@ class FieldTraining {
                 const TrainConfig& train, const std::string& task, double time_unit = 1);
 
   /// Trains `model` (fresh from the run's seed) on `data` or on the windows, with the loop's
-  /// steps, schedule and record interval from `s.train`.
+  /// steps, schedule and record interval from `s.train`; with a sampled fit (s.fit), first
+  /// samples its hidden layers and solves its last layer on data's training split, and with
+  /// --fit sampled stops there.
   template <typename T>
   TrainResult train(nn::DynamicsModel<T>& model, const Dataset& data, const RunSettings& s,
                     const LoopOptions& loop) const;
@@ -49,6 +53,10 @@ class FieldTraining {
   }
 
  private:
+  template <typename T>
+  TrainResult train_through_integrator(nn::DynamicsModel<T>& model, const RunSettings& s,
+                                       const LoopOptions& loop) const;
+
   RolloutLossConfig loss_{};
   RolloutWindows train_windows_{}, test_windows_{};
   int substeps_ = 1;

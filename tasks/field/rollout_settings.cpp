@@ -20,6 +20,7 @@ std::vector<Eigen::MatrixXd> FieldTask::measured_paths(const RunSettings&, int,
 }
 
 std::vector<std::string> FieldTask::evaluation_setting_names() const {
+  if (scattered()) return {};  // no rollouts to set
   const std::vector<std::string> own = own_setting_names();
   std::vector<std::string> names = {"rollouts"};
   if (std::find(own.begin(), own.end(), "t_end") == own.end()) names.push_back("t_end");
@@ -29,7 +30,7 @@ std::vector<std::string> FieldTask::evaluation_setting_names() const {
 
 RolloutConfig FieldTask::rollout_config(const nlohmann::json& settings) const {
   std::vector<std::string> span = evaluation_setting_names();
-  span.erase(span.begin());  // "rollouts"
+  if (!span.empty()) span.erase(span.begin());  // "rollouts"
   RolloutConfig c = rollout_settings(settings, rollout_config(), name(), kMaxRollouts, span);
   c.horizons = short_horizons();
   std::erase_if(c.horizons, [&](double h) { return h > c.t_end; });

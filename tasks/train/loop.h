@@ -19,8 +19,11 @@ namespace hnn::tasks {
 
 struct TrainResult {
   std::vector<CurvePoint> curve{};
-  double seconds = 0;  // the training steps only (no data, no loss-curve points, no evaluation)
+  double seconds = 0;  // the fit and training steps only (no data, loss-curve points, evaluation)
   long steps = 0;
+  /// metrics.json's "fit" where the hidden layers were sampled (tasks/train/fit_method.h);
+  /// null for Adam alone.
+  nlohmann::json fit{};
 };
 
 /// How the learning rate moves over a run: constant, or cosine decay from the set rate at step

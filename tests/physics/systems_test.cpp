@@ -8,6 +8,7 @@
 
 #include "physics/double_pendulum.h"
 #include "physics/gym_pendulum.h"
+#include "physics/henon_heiles.h"
 #include "physics/integrator.h"
 #include "physics/nbody.h"
 #include "physics/oscillators.h"
@@ -26,7 +27,11 @@ std::vector<std::shared_ptr<System>> all_systems() {
           std::make_shared<NBody>(NBody::equal_masses(3)),
           std::make_shared<NBody>(std::vector<double>{1.0, 2.0, 0.5}, 0.7),
           std::make_shared<DoublePendulum>(),
-          std::make_shared<DoublePendulum>(1.5, 0.7, 0.8, 1.3, 3.0)};
+          std::make_shared<DoublePendulum>(1.5, 0.7, 0.8, 1.3, 3.0),
+          std::make_shared<DoublePendulum>(1.0, 1.0, 1.0, 1.0, 1.0,
+                                           DoublePendulum::PotentialZero::kAtPivot),
+          std::make_shared<HenonHeiles>(),
+          std::make_shared<HenonHeiles>(0.3, 2.0)};
 }
 
 TEST(Systems, VectorFieldIsJTimesGradientOfH) {

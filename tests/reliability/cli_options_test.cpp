@@ -49,9 +49,9 @@ std::vector<BadOption> bad_train_options() {
       {{"train", "spring", "--lr", "nan"}, "--lr: " + finite + "'nan'"},
       {{"train", "spring", "--lr", "inf"}, "--lr: " + finite + "'inf'"},
       {{"train", "spring", "--hidden", "0"},
-       "--hidden: expected an integer from 1 to 4096, got '0'"},
+       "--hidden: expected an integer from 1 to 8192, got '0'"},
       {{"train", "spring", "--hidden", "200", "50000"},
-       "--hidden: expected an integer from 1 to 4096, got '50000'"},
+       "--hidden: expected an integer from 1 to 8192, got '50000'"},
       {{"train", "spring", "--threads", "257"},
        "--threads: expected an integer from 1 to 256, got '257'"},
       {{"train", "spring", "--checkpoint-every", "0"}, "--checkpoint-every: " + positive + "'0'"},
@@ -60,7 +60,8 @@ std::vector<BadOption> bad_train_options() {
        "task 'spring' does not read a data file (--data applies to measured-data tasks such as "
        "real-pendulum)"},
       {{"train", "spring", "--settings", "{\"trials\": 20}"},
-       "task 'spring' has no setting 'trials' (known: loss, horizon, integrator, dt, sample_dt, "
+       "task 'spring' has no setting 'trials' (known: loss, horizon, integrator, dt, fit, "
+       "sampler, rcond, solver, regularization, solver_tolerance, solver_iterations, sample_dt, "
        "t_end, rollouts, rollout_t_end)"},
       {{"train", "two-body", "--settings", "{\"rollouts\": 0}"},
        "two-body: rollouts must be an integer from 1 to 1000, got 0"},
@@ -82,6 +83,62 @@ std::vector<BadOption> bad_train_options() {
   };
 }
 
+// --fit sampled takes no steps: the options of Adam's steps are refused with it; its own options
+// are refused without it (docs/inputs.md).
+std::vector<BadOption> bad_fit_options() {
+  const std::string no_steps =
+      " does not apply to --fit sampled: it takes no training steps (the hidden layers are "
+      "sampled, the last layer solved); --fit sampled+adam fine-tunes with Adam from there";
+  std::vector<BadOption> bad;
+  for (const std::vector<std::string> option :
+       std::vector<std::vector<std::string>>{{"--steps", "10"},
+                                             {"--batch", "10"},
+                                             {"--lr", "0.1"},
+                                             {"--lr-schedule", "cosine"},
+                                             {"--checkpoint-every", "5"}}) {
+    bad.push_back(
+        {{"train", "spring", "--fit", "sampled", option[0], option[1]}, option[0] + no_steps});
+  }
+  for (const std::vector<std::string> option :
+       std::vector<std::vector<std::string>>{{"--sampler", "elm"},
+                                             {"--rcond", "1e-10"},
+                                             {"--solver", "qr"},
+                                             {"--regularization", "1e-8"},
+                                             {"--solver-tolerance", "1e-8"},
+                                             {"--solver-iterations", "50"}}) {
+    bad.push_back({{"train", "spring", option[0], option[1]},
+                   "spring: " + option[0] +
+                       " applies to a sampled fit only (add --fit sampled or --fit sampled+adam)"});
+  }
+  const std::vector<BadOption> others = {
+      {{"train", "spring", "--fit", "sampled", "--loss", "rollout"},
+       "spring: --loss rollout does not apply to --fit sampled (the last layer is solved on dx/dt "
+       "targets; --fit sampled+adam fine-tunes through the integrator)"},
+      {{"train", "double-pendulum", "--model", "lnn", "--fit", "sampled+adam"},
+       "double-pendulum: --fit sampled+adam does not fit an lnn: its accelerations are not linear "
+       "in its last layer (they invert the Hessian of L in dq/dt), so no least-squares solve "
+       "gives it (models it fits: hnn, baseline, dhnn)"},
+      {{"train", "spring", "--hidden", "5000"},
+       "--hidden 5000 is wider than Adam trains (4096 at most); --fit sampled takes up to 8192"},
+      {{"train", "spring", "--fit", "sampled", "--model", "baseline", "--hidden", "1000"},
+       "spring: sampled fit: 1000 last-layer unknowns per output but only 750 equations from 750 "
+       "points; lower the width or give more points"},
+      {{"train", "spring", "--fit", "sgd"}, "--fit: sgd not in {adam,sampled,sampled+adam}"},
+      {{"train", "spring", "--fit", "sampled", "--sampler", "gauss"},
+       "--sampler: gauss not in {elm,uswim,aswim}"},
+      {{"train", "spring", "--fit", "sampled", "--solver", "svd"},
+       "--solver: svd not in {lsqr,cholesky,qr}"},
+      {{"train", "spring", "--fit", "sampled", "--rcond", "1"},
+       "spring: --rcond must be in (0, 1), got 1"},
+      {{"train", "spring", "--fit", "sampled", "--regularization", "0"},
+       "--regularization: expected a finite number > 0, got '0'"},
+      {{"train", "spring", "--fit", "sampled", "--solver-iterations", "0"},
+       "--solver-iterations: Value 0 not in range 1 to 100000"},
+  };
+  bad.insert(bad.end(), others.begin(), others.end());
+  return bad;
+}
+
 void expect_one_line_error(const Result& r, const std::string& message, const std::string& what) {
   EXPECT_EQ(r.code, 1) << what;
   // CLI11's own parse errors end with a pointer to --help.
@@ -93,7 +150,9 @@ void expect_one_line_error(const Result& r, const std::string& message, const st
 
 TEST(CliOptions, BadTrainOptionsGetOneLineAndNoRunFolder) {
   const TempDir dir;
-  for (const BadOption& bad : bad_train_options()) {
+  std::vector<BadOption> cases = bad_train_options();
+  for (BadOption& bad : bad_fit_options()) cases.push_back(std::move(bad));
+  for (const BadOption& bad : cases) {
     std::vector<std::string> args = bad.args;
     const fs::path out = dir / "run";
     args.insert(args.end(), {"--quiet", "--out", out.string()});
@@ -153,7 +212,8 @@ TEST(CliOptions, BadCommandsAndOtherSubcommandsGetOneLine) {
        "Could not convert: --no-reversibility = x"},
       {{"reproduce", "--tasks", "spring,nope", "--out", (dir / "results").string()},
        "unknown task 'nope' (known: spring, pendulum, real-pendulum, two-body, three-body, "
-       "pixel-pendulum, damped-spring, double-pendulum, real-double-pendulum, data)"},
+       "pixel-pendulum, damped-spring, double-pendulum, real-double-pendulum, henon-heiles, "
+       "pendulum-scattered, double-pendulum-scattered, data)"},
       {{"reproduce", "--tasks", "data", "--out", (dir / "results").string()},
        "reproduce runs the paper's tasks (spring, pendulum, real-pendulum, two-body, three-body, "
        "pixel-pendulum); 'data' is not one of them: train it with hnn train data"},
@@ -278,7 +338,9 @@ TEST(TrainOptionsTable, TheSweepKeysAreItsRowsInRankOrderAndTheOthersAreRefusedW
       "data": "x.csv", "settings": {"threshold": 0.2}, "checkpoint-every": 2, "coords": "q",
       "momenta": "p", "velocities": "v", "derivatives": "dq,dp", "time": "t",
       "trajectory": "traj", "split": "time", "test-fraction": 0.3, "hamiltonian": "q^2",
-      "loss": "rollout", "horizon": 2, "integrator": "leapfrog", "dt": 0.05})");
+      "loss": "rollout", "horizon": 2, "integrator": "leapfrog", "dt": 0.05,
+      "fit": "sampled+adam", "sampler": "aswim", "rcond": 1e-10, "solver": "qr",
+      "regularization": 1e-9, "solver-tolerance": 1e-10, "solver-iterations": 50})");
   json spec = json::object();
   std::vector<const TrainOption*> keys;
   for (const TrainOption& option : tasks::train_options()) {
@@ -356,6 +418,33 @@ TEST(TrainOptionsTable, TheJsonFormReadsBackAsItWasWrittenAndOldRunsGetTheRecord
     if (option.recorded_default.empty()) continue;
     EXPECT_EQ(back[std::string(option.key)], json::parse(option.recorded_default)) << option.name;
   }
+}
+
+// A sampled fit's settings are task settings: recorded as given, read back to the same fit; an
+// Adam run's settings do not change (no key of the fit).
+TEST(TrainOptionsTable, ASampledFitsSettingsReadBackAsWrittenAndAdamRunsKeepTheirs) {
+  const std::unique_ptr<tasks::Task> task = tasks::make_task("spring");
+  const json given = {{"fit", "sampled"},       {"sampler", "aswim"},
+                      {"rcond", 1e-10},         {"solver", "qr"},
+                      {"regularization", 1e-9}, {"solver_tolerance", 1e-10},
+                      {"solver_iterations", 50}};
+  const tasks::RunSettings s = tasks::resolve(
+      *task, {.task = "spring", .hidden = std::vector<int>{30}, .task_settings = given});
+  const json j = s.to_json();
+  EXPECT_EQ(j.at("task_settings"), given);
+  EXPECT_EQ(j.at("steps"), 0);  // a sampled fit takes none
+  const tasks::RunSettings back = tasks::resolve(*task, tasks::options_from_json(j, "test"));
+  EXPECT_EQ(back.to_json(), j);
+  EXPECT_EQ(back.fit.method, tasks::FitMethod::kSampled);
+  EXPECT_EQ(back.fit.sampled.sampler, nn::HiddenSampler::kAswim);
+  EXPECT_EQ(back.fit.sampled.solver, nn::LeastSquaresSolver::kQr);
+  EXPECT_EQ(back.fit.sampled.rcond, 1e-10);
+  EXPECT_EQ(back.fit.sampled.regularization, 1e-9);
+  EXPECT_EQ(back.fit.sampled.tolerance, 1e-10);
+  EXPECT_EQ(back.fit.sampled.max_iterations, 50);
+  const json adam = tasks::resolve(*task, {.task = "spring"}).to_json();
+  EXPECT_EQ(adam.at("task_settings"), json::object());
+  EXPECT_EQ(adam.at("steps"), task->train_config().steps);
 }
 
 }  // namespace

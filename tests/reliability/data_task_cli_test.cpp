@@ -16,13 +16,7 @@ struct BadTrain {
 
 TEST(DataTaskCli, TrainsOnASimulatedFileAndRefusesBadOptionsInOneLine) {
   const TempDir dir;
-  const std::string csv = (dir / "pend.csv").string(), out = (dir / "run").string();
-  ASSERT_EQ(
-      run_hnn({"simulate", "--hamiltonian", "p^2/2 + 2*(1 - cos(q))", "--coords", "q", "--momenta",
-               "p", "--trajectories", "10", "--t-end", "2", "--points", "15", "--out", csv},
-              dir.path())
-          .code,
-      0);
+  const std::string csv = simulated_pendulum_csv(dir.path()), out = (dir / "run").string();
   const std::vector<std::string> base = {"train",    "data",      "--data",  csv,       "--coords",
                                          "q",        "--momenta", "p",       "--steps", "30",
                                          "--hidden", "8",         "--quiet", "--out",   out};

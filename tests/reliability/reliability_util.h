@@ -156,6 +156,18 @@ inline fs::path shipped_pendulum_data() {
   return fs::path(HNN_SOURCE_DIR) / "data" / "lipson" / "real_pend_h_1.txt";
 }
 
+/// A pendulum's trajectories with exact dx/dt, written by `hnn simulate` into dir/pend.csv (10
+/// trajectories of 15 points): the data task's test file. Returns its path.
+inline std::string simulated_pendulum_csv(const fs::path& dir) {
+  const std::string csv = (dir / "pend.csv").string();
+  const Result r =
+      run_hnn({"simulate", "--hamiltonian", "p^2/2 + 2*(1 - cos(q))", "--coords", "q", "--momenta",
+               "p", "--trajectories", "10", "--t-end", "2", "--points", "15", "--out", csv},
+              dir);
+  EXPECT_EQ(r.code, 0) << r.err;
+  return csv;
+}
+
 /// metrics.json without the keys that measure time (the only ones two runs may differ in).
 inline nlohmann::json without_timings(nlohmann::json metrics) {
   for (const char* key : {"train_seconds", "eval_seconds", "data_seconds"}) metrics.erase(key);

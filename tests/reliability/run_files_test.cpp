@@ -138,17 +138,17 @@ TEST_F(RunFiles, BadMetricsFilesAreRefused) {
        "'RUN/metrics.json' does not hold a run's settings: seed is \"7\", not an integer from 0 "
        "to 18446744073709551615"},
       {"bad-hidden", [](const fs::path& r) { set_metric(r, "hidden", "8-x"); },
-       "'RUN/metrics.json' does not hold a run's settings: hidden '8-x' is not widths of 1..4096 "
+       "'RUN/metrics.json' does not hold a run's settings: hidden '8-x' is not widths of 1..8192 "
        "joined by '-' (like 200-200)"},
       {"huge-hidden", [](const fs::path& r) { set_metric(r, "hidden", "99999999999"); },
        "'RUN/metrics.json' does not hold a run's settings: hidden '99999999999' is not widths "
-       "of 1..4096 joined by '-' (like 200-200)"},
-      // Widths that are integers but not 1..4096 are the file's fault too, not an option's.
-      {"wide-hidden", [](const fs::path& r) { set_metric(r, "hidden", "8-5000"); },
-       "'RUN/metrics.json' does not hold a run's settings: hidden '8-5000' is not widths of "
-       "1..4096 joined by '-' (like 200-200)"},
+       "of 1..8192 joined by '-' (like 200-200)"},
+      // Widths that are integers but not 1..8192 are the file's fault too, not an option's.
+      {"wide-hidden", [](const fs::path& r) { set_metric(r, "hidden", "8-9000"); },
+       "'RUN/metrics.json' does not hold a run's settings: hidden '8-9000' is not widths of "
+       "1..8192 joined by '-' (like 200-200)"},
       {"zero-hidden", [](const fs::path& r) { set_metric(r, "hidden", "0"); },
-       "'RUN/metrics.json' does not hold a run's settings: hidden '0' is not widths of 1..4096 "
+       "'RUN/metrics.json' does not hold a run's settings: hidden '0' is not widths of 1..8192 "
        "joined by '-' (like 200-200)"},
       {"unknown-task", [](const fs::path& r) { set_metric(r, "task", "nope"); },
        "unknown task 'nope' (known: spring, pendulum, real-pendulum, two-body, three-body"},

@@ -53,10 +53,42 @@ TEST_F(MeasuredDataErrors, BadColumnChoices) {
             "FILE: column 'time' is chosen twice (as the time and as a coordinate)");
   EXPECT_EQ(message(kFile, {.coords = {"q"}, .momenta = {"p"}, .trajectory = "q"}),
             "FILE: column 'q' is chosen twice (as the trajectory id and as a coordinate)");
-  EXPECT_EQ(
-      message("a,q,p\n0,0,0\n", qp()),
-      "FILE: no time column (none is named t, time or times): give it by name or index (columns: "
-      "a, q, p)");
+  EXPECT_EQ(message("a,q,p\n0,0,0\n", qp()),
+            "FILE: no time column (none is named t, time or times) and no derivative columns: "
+            "give the time column by name or index, or for scattered states dx/dt of every state "
+            "column (named d<x>/dt, or chosen with --derivatives) (columns: a, q, p)");
+  // Some derivative columns found, not all: the note says which.
+  EXPECT_EQ(message("q,p,dq/dt\n0,0,0\n", qp()),
+            "FILE: no time column (none is named t, time or times) and no derivative columns "
+            "(derivative columns dq/dt found, none for p: --derivatives names them all): give the "
+            "time column by name or index, or for scattered states dx/dt of every state column "
+            "(named d<x>/dt, or chosen with --derivatives) (columns: q, p, dq/dt)");
+}
+
+// A file without a time column but with every derivative column: scattered states, split by
+// rows (the last are the test set), with no trajectories or stretches.
+TEST_F(MeasuredDataErrors, ScatteredStatesAreReadWithoutTime) {
+  const std::string csv = "q,p,dq/dt,dp/dt\n1,2,3,4\n5,6,7,8\n9,10,11,12\n13,14,15,16\n";
+  const std::string path = write("s.csv", csv);
+  const MeasuredTrajectories m = select_trajectories(read_table(path), qp());
+  EXPECT_TRUE(m.scattered);
+  ASSERT_EQ(m.segments.size(), 1u);
+  EXPECT_EQ(m.segments[0].t.size(), 0);
+  const MeasuredData d = split_trajectories(m, {.test_fraction = 0.25});
+  EXPECT_TRUE(d.scattered);
+  ASSERT_EQ(d.data.train_x.rows(), 3);
+  ASSERT_EQ(d.data.test_x.rows(), 1);
+  EXPECT_EQ(d.data.test_x(0, 1), 14);
+  EXPECT_EQ(d.data.test_dxdt(0, 0), 15);
+  EXPECT_EQ(d.data.train_dxdt(2, 1), 12);
+  EXPECT_TRUE(d.held_out.empty());
+  EXPECT_TRUE(d.train_stretches.empty());
+  EXPECT_NE(describe(d).find("split by rows: 3 training rows, 1 test rows"), std::string::npos)
+      << describe(d);
+  EXPECT_EQ(error_of([&] { split_trajectories(m, {.by = SplitBy::kTrajectories}); }),
+            path +
+                ": split by trajectories needs trajectories, and the file holds scattered states "
+                "(no time column): leave the split at auto (the last rows are the test set)");
 }
 
 TEST_F(MeasuredDataErrors, NpzCoordinatesAndMomentaOfDifferentCounts) {

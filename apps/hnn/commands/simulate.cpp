@@ -1,5 +1,7 @@
-// `hnn simulate`: trajectories of any Hamiltonian given as an expression, with the exact time
-// derivatives at the clean states, as CSV (noise, if any, on the states only).
+// `hnn simulate`: trajectories of any Hamiltonian given as an expression, or states scattered
+// over the sampling box (--scattered N, no time column: the sampled-HNN paper's kind of data),
+// with the exact time derivatives at the clean states, as CSV (noise, if any, on the states
+// only).
 
 #include "physics/simulate.h"
 
@@ -27,7 +29,7 @@ constexpr double kMaxRows = 1e8;  // trajectories x points held in memory at onc
 struct SimulateOptions {
   std::string hamiltonian, sample, energy, out, integrator = "dopri5";
   std::vector<std::string> coords, momenta;
-  int trajectories = 0, points = 0;
+  int trajectories = 0, points = 0, scattered = 0;
   double t_end = 0.0, noise = 0.0, dt = 1e-2, rtol = 1e-10;
   std::uint64_t seed = 0;
 };
@@ -89,18 +91,22 @@ physics::Batch integrate(const physics::ExpressionSystem& system, const physics:
   return states;
 }
 
+// Trajectories with their id and time first; scattered states (o.scattered) without either.
 std::string csv(const physics::ExpressionSystem& system, const physics::Batch& x,
                 const physics::Batch& dxdt, const SimulateOptions& o) {
   const std::vector<std::string> names = system.variables();
+  const bool timed = o.scattered == 0;
   fmt::memory_buffer out;
-  fmt::format_to(std::back_inserter(out), "trajectory,t");
-  for (const std::string& name : names) fmt::format_to(std::back_inserter(out), ",{}", name);
+  if (timed) fmt::format_to(std::back_inserter(out), "trajectory,t,");
+  fmt::format_to(std::back_inserter(out), "{}", fmt::join(names, ","));
   for (const std::string& name : names) fmt::format_to(std::back_inserter(out), ",d{}/dt", name);
-  const std::vector<double> times = physics::linspace(0.0, o.t_end, o.points);
+  const std::vector<double> times = physics::linspace(0.0, o.t_end, std::max(o.points, 2));
   for (Eigen::Index row = 0; row < x.rows(); ++row) {
-    fmt::format_to(std::back_inserter(out), "\n{},{}", row / o.points, times[row % o.points]);
+    out.push_back('\n');
+    if (timed)
+      fmt::format_to(std::back_inserter(out), "{},{},", row / o.points, times[row % o.points]);
     for (Eigen::Index j = 0; j < x.cols(); ++j)
-      fmt::format_to(std::back_inserter(out), ",{}", x(row, j));
+      fmt::format_to(std::back_inserter(out), "{}{}", j ? "," : "", x(row, j));
     for (Eigen::Index j = 0; j < x.cols(); ++j) {
       fmt::format_to(std::back_inserter(out), ",{}", dxdt(row, j));
     }
@@ -109,7 +115,18 @@ std::string csv(const physics::ExpressionSystem& system, const physics::Batch& x
   return fmt::to_string(out);
 }
 
+// Either trajectories (--trajectories, --t-end and --points) or scattered states.
+void check_kind(const SimulateOptions& o) {
+  if (o.scattered > 0) return;  // the options of trajectories exclude it (add_simulate_command)
+  if (o.trajectories == 0 || o.t_end == 0 || o.points == 0) {
+    throw std::invalid_argument(
+        "give --trajectories, --t-end and --points for trajectories, or --scattered N for N "
+        "states without time (uniform in --sample's box, with exact dx/dt)");
+  }
+}
+
 void simulate(const SimulateOptions& o) {
+  check_kind(o);
   if (double(o.trajectories) * o.points > kMaxRows) {
     throw std::invalid_argument(
         fmt::format("--trajectories {} x --points {} is more than {:g} rows", o.trajectories,
@@ -117,8 +134,9 @@ void simulate(const SimulateOptions& o) {
   }
   const physics::ExpressionSystem system = make_system(o);
   std::mt19937_64 rng(o.seed);
-  const physics::Batch x0 = system.sample_initial_states(o.trajectories, rng);
-  physics::Batch x = integrate(system, x0, o);
+  physics::Batch x =
+      system.sample_initial_states(o.scattered > 0 ? o.scattered : o.trajectories, rng);
+  if (o.scattered == 0) x = integrate(system, x, o);
   physics::Batch dxdt;
   system.vector_field(x, dxdt);  // the exact derivatives at the clean states
   if (o.noise > 0.0) {
@@ -126,6 +144,11 @@ void simulate(const SimulateOptions& o) {
     for (Eigen::Index i = 0; i < x.size(); ++i) x.data()[i] += normal(rng);
   }
   nn::write_file_atomic(o.out, csv(system, x, dxdt, o));
+  if (o.scattered > 0) {
+    fmt::print("hnn simulate: {} scattered states of {} with exact dx/dt, no time column -> {}\n",
+               o.scattered, system.name(), o.out);
+    return;
+  }
   fmt::print("hnn simulate: {} trajectories x {} points of {} ({}{}) -> {}\n", o.trajectories,
              o.points, system.name(), o.integrator,
              system.separable() ? ", separable" : ", not separable", o.out);
@@ -160,30 +183,36 @@ void add_simulate_command(CLI::App& app) {
       ->option_text("NAME ...")
       ->required()
       ->delimiter(',');
-  cmd->add_option("--trajectories", o->trajectories, "Trajectories")
-      ->required()
-      ->check(integer_in(1, 10000000));
-  cmd->add_option("--t-end", o->t_end, "Time span of each trajectory")
-      ->required()
-      ->check(positive_real());
-  cmd->add_option("--points", o->points, "Evenly spaced times from 0 to --t-end")
-      ->required()
-      ->check(integer_in(2, 10000000));
+  // Trajectories, or --scattered states: the options of trajectories exclude it.
+  std::vector<CLI::Option*> timed = {
+      cmd->add_option("--trajectories", o->trajectories, "Trajectories")
+          ->check(integer_in(1, 10000000)),
+      cmd->add_option("--t-end", o->t_end, "Time span of each trajectory")->check(positive_real()),
+      cmd->add_option("--points", o->points, "Evenly spaced times from 0 to --t-end")
+          ->check(integer_in(2, 10000000))};
   cmd->add_option("--noise", o->noise, "Gaussian noise std added to the states (not to dx/dt)")
       ->check(non_negative_real())
       ->capture_default_str();
-  cmd->add_option("--integrator", o->integrator,
-                  fmt::format("One of {} (the splitting methods leapfrog, yoshida4 and "
-                              "symplectic_euler need a separable H)",
-                              fmt::join(physics::integrator_names(), ", ")))
-      ->option_text("NAME")
-      ->capture_default_str();
-  cmd->add_option("--dt", o->dt, "Step of fixed-step integrators")
-      ->check(positive_real())
-      ->capture_default_str();
-  cmd->add_option("--rtol", o->rtol, "Tolerance of dopri5")
-      ->check(positive_real())
-      ->capture_default_str();
+  timed.push_back(
+      cmd->add_option("--integrator", o->integrator,
+                      fmt::format("One of {} (the splitting methods leapfrog, yoshida4 and "
+                                  "symplectic_euler need a separable H)",
+                                  fmt::join(physics::integrator_names(), ", ")))
+          ->option_text("NAME")
+          ->capture_default_str());
+  timed.push_back(cmd->add_option("--dt", o->dt, "Step of fixed-step integrators")
+                      ->check(positive_real())
+                      ->capture_default_str());
+  timed.push_back(cmd->add_option("--rtol", o->rtol, "Tolerance of dopri5")
+                      ->check(positive_real())
+                      ->capture_default_str());
+  CLI::Option* scattered =
+      cmd->add_option("--scattered", o->scattered,
+                      "Instead of trajectories: N states uniform in --sample's box with their "
+                      "exact dx/dt, without time or trajectory columns")
+          ->option_text("N")
+          ->check(integer_in(1, 10000000));
+  for (CLI::Option* option : timed) scattered->excludes(option);
   cmd->add_option("--seed", o->seed, "Seed of the initial states and the noise")
       ->check(seed_value())
       ->capture_default_str();

@@ -10,7 +10,9 @@ namespace hnn::app {
 
 /// The run's task and model; its losses with standard errors and R^2 (a data run's also in the
 /// standardised units of its progress line); its rollouts beside the truth's (the valid
-/// prediction time beside the floor's, the energy error absolute and relative); the time taken.
+/// prediction time beside the floor's, the energy error absolute and relative), or that a run
+/// on scattered states has none; the learned H's error on the held-out points; for a sampled
+/// fit, its time split and system; the time taken.
 /// Each line only when the run has its keys. Ends with a newline.
 std::string metrics_summary(const nlohmann::json& metrics);
 

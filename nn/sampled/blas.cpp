@@ -1,0 +1,100 @@
+#include "nn/sampled/blas.h"
+
+#include <cblas.h>
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <stdexcept>
+#include <vector>
+
+#include "autodiff/parallel.h"
+
+// LAPACK's Fortran entry points (OpenBLAS carries them; Debian ships no lapacke.h beside it).
+extern "C" {
+void dpotrf_(const char* uplo, const int* n, double* a, const int* lda, int* info);
+void dgeqrf_(const int* m, const int* n, double* a, const int* lda, double* tau, double* work,
+             const int* lwork, int* info);
+void dormqr_(const char* side, const char* trans, const int* m, const int* n, const int* k,
+             const double* a, const int* lda, const double* tau, double* c, const int* ldc,
+             double* work, const int* lwork, int* info);
+void dgelsd_(const int* m, const int* n, const int* nrhs, double* a, const int* lda, double* b,
+             const int* ldb, double* s, const double* rcond, int* rank, double* work,
+             const int* lwork, int* iwork, int* info);
+}
+
+namespace hnn::nn::sampled {
+
+BlasThreads::BlasThreads() { openblas_set_num_threads(ad::num_threads()); }
+BlasThreads::~BlasThreads() { openblas_set_num_threads(1); }
+
+void blas_gemm(const ColMat& a, bool ta, const ColMat& b, bool tb, ColMat& c, double beta) {
+  const auto m = int(c.rows()), n = int(c.cols());
+  const auto k = int(ta ? a.rows() : a.cols());
+  cblas_dgemm(CblasColMajor, ta ? CblasTrans : CblasNoTrans, tb ? CblasTrans : CblasNoTrans, m, n,
+              k, 1.0, a.data(), int(a.rows()), b.data(), int(b.rows()), beta, c.data(),
+              int(c.rows()));
+}
+
+void blas_gram(const double* a, Eigen::Index rows, Eigen::Index cols, Eigen::Index lda, ColMat& g,
+               double beta) {
+  cblas_dsyrk(CblasColMajor, CblasLower, CblasTrans, int(cols), int(rows), 1.0, a, int(lda), beta,
+              g.data(), int(g.rows()));
+  g.triangularView<Eigen::StrictlyUpper>() = g.transpose();
+}
+
+bool cholesky_upper(ColMat& g) {
+  const auto n = int(g.rows());
+  int info = 0;
+  dpotrf_("U", &n, g.data(), &n, &info);
+  return info == 0;
+}
+
+ColMat qr_apply(ColMat& a, ColMat& b) {
+  const auto m = int(a.rows()), n = int(a.cols()), nrhs = int(b.cols());
+  std::vector<double> tau(static_cast<std::size_t>(n));
+  int info = 0, lwork = -1;
+  double query_qr = 0, query_q = 0;  // workspace queries (lwork -1)
+  dgeqrf_(&m, &n, a.data(), &m, tau.data(), &query_qr, &lwork, &info);
+  dormqr_("L", "T", &m, &nrhs, &n, a.data(), &m, tau.data(), b.data(), &m, &query_q, &lwork, &info);
+  lwork = std::max(1, int(std::max(query_qr, query_q)));
+  std::vector<double> work(static_cast<std::size_t>(lwork));
+  dgeqrf_(&m, &n, a.data(), &m, tau.data(), work.data(), &lwork, &info);
+  if (info == 0) {
+    dormqr_("L", "T", &m, &nrhs, &n, a.data(), &m, tau.data(), b.data(), &m, work.data(), &lwork,
+            &info);
+  }
+  if (info != 0) {
+    throw std::runtime_error(
+        fmt::format("sampled fit: LAPACK dgeqrf/dormqr failed (info {})", info));
+  }
+  return a.topRows(n).triangularView<Eigen::Upper>();
+}
+
+void solve_upper(const ColMat& r, bool transpose, ColMat& y) {
+  cblas_dtrsm(CblasColMajor, CblasLeft, CblasUpper, transpose ? CblasTrans : CblasNoTrans,
+              CblasNonUnit, int(y.rows()), int(y.cols()), 1.0, r.data(), int(r.rows()), y.data(),
+              int(y.rows()));
+}
+
+int lstsq_svd(ColMat& a, ColMat& b, double rcond) {
+  const auto m = int(a.rows()), n = int(a.cols()), nrhs = int(b.cols());
+  const int ldb = std::max(m, n);
+  if (b.rows() < ldb) b.conservativeResize(ldb, Eigen::NoChange);
+  std::vector<double> s(std::size_t(std::min(m, n)));
+  int rank = 0, info = 0, lwork = -1;
+  double query = 0;
+  int iquery = 0;
+  dgelsd_(&m, &n, &nrhs, a.data(), &m, b.data(), &ldb, s.data(), &rcond, &rank, &query, &lwork,
+          &iquery, &info);
+  lwork = int(query);
+  std::vector<double> work(std::size_t(std::max(lwork, 1)));
+  std::vector<int> iwork(std::size_t(std::max(iquery, 1)));
+  dgelsd_(&m, &n, &nrhs, a.data(), &m, b.data(), &ldb, s.data(), &rcond, &rank, work.data(), &lwork,
+          iwork.data(), &info);
+  if (info != 0) {
+    throw std::runtime_error(fmt::format("sampled fit: LAPACK dgelsd failed (info {})", info));
+  }
+  return rank;
+}
+
+}  // namespace hnn::nn::sampled

@@ -1,0 +1,39 @@
+#pragma once
+// The dense linear algebra of the sampled fit, on Debian's OpenBLAS (pthreads build, with its
+// LAPACK): column-major Eigen matrices handed to cblas and to LAPACK's Fortran routines.
+
+#include <Eigen/Core>
+
+namespace hnn::nn::sampled {
+
+using ColMat = Eigen::MatrixXd;
+
+/// OpenBLAS uses ad::num_threads() threads while this lives, then one again: the engine calls
+/// OpenBLAS's serial GEMM from its own threads (autodiff/gemm.cpp), but the fit's big products
+/// run alone and are worth both cores.
+class BlasThreads {
+ public:
+  BlasThreads();
+  ~BlasThreads();
+  BlasThreads(const BlasThreads&) = delete;
+  BlasThreads& operator=(const BlasThreads&) = delete;
+};
+
+/// c = op(a) op(b) + beta c (op: transpose when the flag is set); c must have the right size.
+void blas_gemm(const ColMat& a, bool ta, const ColMat& b, bool tb, ColMat& c, double beta = 0);
+/// g = a^T a + beta g for the `rows` x `cols` column-major block at `a` (leading dimension
+/// lda), both triangles filled: one dsyrk, the floor of the normal-equation solvers.
+void blas_gram(const double* a, Eigen::Index rows, Eigen::Index cols, Eigen::Index lda, ColMat& g,
+               double beta);
+/// g = R^T R in place (the upper triangle holds R); false when g is not positive definite.
+bool cholesky_upper(ColMat& g);
+/// a = QR in place (Householder, LAPACK's dgeqrf), then b <- Q^T b; returns R (a.cols() square).
+ColMat qr_apply(ColMat& a, ColMat& b);
+/// y <- R^-1 y, or y <- R^-T y (transpose), for an upper-triangular R.
+void solve_upper(const ColMat& r, bool transpose, ColMat& y);
+/// min |a x - b| by LAPACK's dgelsd (the SVD solver np.linalg.lstsq runs); singular values below
+/// rcond times the largest are dropped. a is destroyed; b (rows x m) returns x in its first
+/// a.cols() rows. Returns the effective rank; throws std::runtime_error when dgelsd fails.
+int lstsq_svd(ColMat& a, ColMat& b, double rcond);
+
+}  // namespace hnn::nn::sampled

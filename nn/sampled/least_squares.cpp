@@ -1,0 +1,201 @@
+#include "nn/sampled/least_squares.h"
+
+#include <fmt/format.h>
+
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+namespace hnn::nn::sampled {
+
+using Eigen::Index;
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// The right preconditioner c = S R^-1 y: R upper triangular, S a column scaling.
+struct Preconditioner {
+  ColMat r;
+  Eigen::VectorXd s;
+
+  void apply(const ColMat& y, ColMat& c) const {  // c = S R^-1 y, in c's own memory
+    c = y;
+    solve_upper(r, false, c);
+    c.array().colwise() *= s.array();
+  }
+  void apply_t(const ColMat& c, ColMat& y) const {  // y = R^-T S c
+    y = c;
+    y.array().colwise() *= s.array();
+    solve_upper(r, true, y);
+  }
+};
+
+// The normal equations' factor: columns scaled to unit norm (s = diag(A^T A)^-1/2: SWIM's
+// neurons differ in slope by orders of magnitude), then R^T R = S A^T A S + lambda I, lambda
+// raised tenfold while the factorisation fails (the scaled Gram's rounding is about 1e-16, so
+// a lambda near it may not make the computed matrix positive definite).
+constexpr double kLargestRegularization = 1e-6;
+
+Preconditioner cholesky_preconditioner(const ColMat& gram, double regularization, double& used) {
+  const Index p = gram.rows();
+  for (Index j = 0; j < p; ++j) {
+    if (!(gram(j, j) > 0)) {
+      throw std::invalid_argument(fmt::format(
+          "sampled fit: the last layer's system is singular: unknown {} (neuron {}) has no "
+          "equation (its input gradient is zero at every data point)",
+          j, j));
+    }
+  }
+  Preconditioner m{ColMat(p, p), {}};
+  m.s = gram.diagonal().cwiseMax(std::numeric_limits<double>::min()).cwiseSqrt().cwiseInverse();
+  for (used = regularization; used <= kLargestRegularization; used *= 10) {
+    m.r = m.s.asDiagonal() * gram * m.s.asDiagonal();
+    m.r.diagonal().array() += used;
+    if (cholesky_upper(m.r)) {
+      m.r.triangularView<Eigen::StrictlyLower>().setZero();
+      return m;
+    }
+    if (used == 0) used = 1e-16;
+  }
+  throw std::invalid_argument(
+      fmt::format("sampled fit: the last layer's normal matrix is singular (Cholesky failed up to "
+                  "regularisation {:g}); lower the width or give more distinct points",
+                  kLargestRegularization));
+}
+
+// LSQR (Paige & Saunders 1982) on A M (M the preconditioner), started from c: it solves for the
+// correction, and returns the iterations.
+struct Lsqr {
+  const LinearSystem& a;
+  const Preconditioner& m;
+  ColMat u, v, w, x, av, atu;
+
+  ColMat c_space;  // a vector of unknowns (M's output)
+
+  Lsqr(const LinearSystem& system, const Preconditioner& preconditioner)
+      : a(system),
+        m(preconditioner),
+        u(system.equations(), system.rhs_columns()),
+        v(preconditioner.r.rows(), system.rhs_columns()),
+        w(v),
+        x(v),
+        av(u),
+        atu(v),
+        c_space(system.unknowns(), system.rhs_columns()) {}
+
+  void forward(const ColMat& y, ColMat& out) {  // out = A M y
+    m.apply(y, c_space);
+    a.apply(c_space, out);
+  }
+  void backward(const ColMat& r, ColMat& out) {  // out = M^T A^T r
+    a.apply_t(r, c_space);
+    m.apply_t(c_space, out);
+  }
+
+  int run(ColMat& c, double tolerance, int max_iterations) {
+    a.apply(c, u);
+    u = a.rhs() - u;
+    double beta = u.norm();
+    if (beta == 0) return 0;
+    u /= beta;
+    backward(u, v);
+    double alpha = v.norm();
+    if (alpha == 0) return 0;
+    v /= alpha;
+    w = v;
+    x.setZero();
+    double phibar = beta, rhobar = alpha, anorm2 = 0;
+    int it = 0;
+    while (it < max_iterations) {
+      ++it;
+      forward(v, av);
+      u = av - alpha * u;
+      beta = u.norm();
+      if (beta > 0) u /= beta;
+      anorm2 += alpha * alpha + beta * beta;
+      backward(u, atu);
+      v = atu - beta * v;
+      alpha = v.norm();
+      if (alpha > 0) v /= alpha;
+      const double rho = std::hypot(rhobar, beta), cs = rhobar / rho, sn = beta / rho;
+      const double theta = sn * alpha, phi = cs * phibar;
+      rhobar = -cs * alpha;
+      phibar = sn * phibar;
+      x += (phi / rho) * w;
+      w = v - (theta / rho) * w;
+      // |(A M)^T r| = phibar alpha |cs| against |A M| |r| (Paige & Saunders' test 2).
+      if (alpha * std::abs(cs) <= tolerance * std::sqrt(anorm2) || alpha == 0) break;
+    }
+    m.apply(x, c_space);
+    c += c_space;
+    return it;
+  }
+};
+
+void check_finite(const ColMat& c) {
+  if (!c.allFinite()) {
+    throw std::invalid_argument(
+        "sampled fit: the least-squares solution is not finite (a singular system)");
+  }
+}
+
+// dgelsd on the formed matrix (or the Hadamard form's reduction, dim times shorter): the
+// reference, at the memory of A (of D and the reduction).
+void solve_by_svd(const LinearSystem& system, double rcond, LeastSquaresResult& out) {
+  auto start = Clock::now();
+  ColMat a, b;
+  system.reduced(a, b);
+  out.gram_seconds = seconds_since(start);
+  out.bytes = std::size_t(a.size() + b.size()) * sizeof(double);
+  start = Clock::now();
+  lstsq_svd(a, b, rcond);
+  out.c = b.topRows(system.unknowns());
+  out.solve_seconds = seconds_since(start);
+}
+
+}  // namespace
+
+LeastSquaresResult solve_least_squares(const LinearSystem& system, const SampledFitConfig& config) {
+  const BlasThreads threads;
+  LeastSquaresResult out;
+  const Index p = system.unknowns();
+  if (config.solver == LeastSquaresSolver::kQr) {
+    solve_by_svd(system, config.rcond, out);
+  } else {
+    auto start = Clock::now();
+    ColMat g(p, p);
+    system.gram(g);
+    ColMat atb(p, system.rhs_columns());
+    system.apply_t(system.rhs(), atb);
+    out.gram_seconds = seconds_since(start);
+    out.bytes = std::size_t(g.size()) * sizeof(double);
+    start = Clock::now();
+    const Preconditioner m = cholesky_preconditioner(g, config.regularization, out.regularization);
+    g = ColMat();  // the factor is a copy: the Gram's memory goes back before LSQR allocates
+    ColMat y(p, atb.cols());
+    m.apply_t(atb, y);
+    out.c.resize(p, atb.cols());
+    m.apply(y, out.c);
+    check_finite(out.c);
+    if (config.solver == LeastSquaresSolver::kLsqr) {
+      Lsqr lsqr(system, m);
+      out.bytes += std::size_t(lsqr.u.size() * 2 + lsqr.v.size() * 4) * sizeof(double);
+      out.iterations = lsqr.run(out.c, config.tolerance, config.max_iterations);
+    }
+    out.solve_seconds = seconds_since(start);
+  }
+  check_finite(out.c);
+  ColMat r(system.equations(), system.rhs_columns());
+  system.apply(out.c, r);
+  r -= system.rhs();
+  out.residual_rms = r.norm() / std::sqrt(double(r.size()));
+  return out;
+}
+
+}  // namespace hnn::nn::sampled

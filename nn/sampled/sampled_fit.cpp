@@ -1,0 +1,193 @@
+#include "nn/sampled/sampled_fit.h"
+
+#include <fmt/format.h>
+
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <random>
+#include <stdexcept>
+
+#include "nn/sampled/features.h"
+#include "nn/sampled/least_squares.h"
+#include "nn/sampled/samplers.h"
+
+namespace hnn::nn {
+
+using Eigen::Index;
+using sampled::ColMat;
+using sampled::HiddenLayer;
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_from(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+void check_matrix(const char* what, const Matrix<double>& m, Index dim) {
+  if (m.cols() != dim || m.rows() < 1) {
+    throw std::invalid_argument(fmt::format("sampled fit: {} is {} x {}, the model takes N x {}",
+                                            what, m.rows(), m.cols(), dim));
+  }
+  for (Index r = 0; r < m.rows(); ++r) {
+    for (Index c = 0; c < m.cols(); ++c) {
+      if (!std::isfinite(m(r, c))) {
+        throw std::invalid_argument(fmt::format(
+            "sampled fit: {} row {} column {} is not finite ({})", what, r, c, m(r, c)));
+      }
+    }
+  }
+}
+
+void check_inputs(const DynamicsConfig& config, const Matrix<double>& x,
+                  const Matrix<double>& dxdt) {
+  if (config.model == ModelKind::kLnn) {
+    throw std::invalid_argument(
+        "sampled fit: an LNN's accelerations solve a system with the Hessian d2L/dv2, which is not "
+        "linear in the last layer's weights, so no least-squares fit exists; train it with Adam");
+  }
+  check_matrix("x", x, config.dim);
+  check_matrix("dxdt", dxdt, config.dim);
+  if (x.rows() != dxdt.rows()) {
+    throw std::invalid_argument(
+        fmt::format("sampled fit: x has {} rows but dxdt has {}", x.rows(), dxdt.rows()));
+  }
+}
+
+// The hidden layers and the last layer's weights (unknowns x m) of one fit.
+struct Fitted {
+  std::vector<HiddenLayer> layers;
+  ColMat last_hidden;  // the last hidden layer's outputs at the data (N x width), when kept
+  ColMat c;
+};
+
+std::vector<HiddenLayer> sample_hidden(const DynamicsConfig& mc, const ColMat& x,
+                                       HiddenSampler sampler, const ColMat* target,
+                                       std::mt19937_64& rng, ColMat* last_hidden) {
+  std::vector<HiddenLayer> layers;
+  ColMat h = sampled::mlp_input(mc, x);
+  for (Index width : mc.hidden) {
+    layers.push_back(sampled::sample_layer(h, width, sampler, mc.activation, target, rng));
+    if (layers.size() == mc.hidden.size() && !last_hidden) break;
+    ColMat value;
+    sampled::activate(mc.activation, sampled::pre_activation(layers.back(), h), value, nullptr);
+    h.swap(value);
+  }
+  if (last_hidden) last_hidden->swap(h);
+  return layers;
+}
+
+// The last layer's system: the baseline's outputs, an HNN's field rows (Hadamard form for one
+// hidden layer on unembedded inputs, else formed through every layer).
+std::unique_ptr<sampled::LinearSystem> last_layer_system(const DynamicsConfig& mc,
+                                                         const Fitted& fit, const ColMat& x,
+                                                         const ColMat& dxdt) {
+  if (mc.model == ModelKind::kBaseline) {
+    return std::make_unique<sampled::DenseSystem>(fit.last_hidden, dxdt);
+  }
+  if (fit.layers.size() > 1 || mc.angles > 0) {
+    return std::make_unique<sampled::DenseSystem>(sampled::field_matrix(mc, fit.layers, x),
+                                                  ColMat(dxdt.reshaped()));
+  }
+  const HiddenLayer& layer = fit.layers.front();
+  const Index w = layer.w.cols();
+  ColMat z = sampled::pre_activation(layer, sampled::mlp_input(mc, x)), slope;
+  sampled::activate(mc.activation, z, z, &slope);  // elementwise: the values overwrite z
+  const auto terms = sampled::field_terms(mc);
+  ColMat v(mc.dim, Index(terms.size()) * w);
+  for (std::size_t s = 0; s < terms.size(); ++s) {
+    for (Index i = 0; i < mc.dim; ++i) {
+      const sampled::FieldTerm t = terms[s][std::size_t(i)];
+      const double scale = mc.input_scale.empty() ? 1.0 : mc.input_scale[std::size_t(t.source)];
+      v.row(i).segment(Index(s) * w, w) = (t.sign / scale) * layer.w.row(t.source);
+    }
+  }
+  return std::make_unique<sampled::HadamardSystem>(std::move(slope), std::move(v), dxdt);
+}
+
+// keep_last: the last hidden layer's outputs are needed (the baseline's matrix, A-SWIM's target).
+Fitted fit_once(const DynamicsConfig& mc, const ColMat& x, const ColMat& dxdt,
+                const SampledFitConfig& config, HiddenSampler sampler, const ColMat* target,
+                bool keep_last, std::mt19937_64& rng, SampledFitReport& report) {
+  Fitted fit;
+  auto start = Clock::now();
+  fit.layers = sample_hidden(mc, x, sampler, target, rng, keep_last ? &fit.last_hidden : nullptr);
+  report.sample_seconds += seconds_from(start);
+  start = Clock::now();
+  const auto system = last_layer_system(mc, fit, x, dxdt);
+  report.assemble_seconds += seconds_from(start);
+  report.rows = std::size_t(system->equations() * system->rhs_columns());
+  report.columns = std::size_t(system->unknowns() * system->rhs_columns());
+  if (system->unknowns() > system->equations()) {
+    throw std::invalid_argument(fmt::format(
+        "sampled fit: {} last-layer unknowns per output but only {} equations from {} points; "
+        "lower the width or give more points",
+        system->unknowns(), system->equations(), x.rows()));
+  }
+  const sampled::LeastSquaresResult solved = sampled::solve_least_squares(*system, config);
+  report.assemble_seconds += solved.gram_seconds;
+  report.gram_seconds += solved.gram_seconds;
+  report.solve_seconds += solved.solve_seconds;
+  report.iterations = solved.iterations;
+  report.regularization = solved.regularization;
+  report.residual_rms = solved.residual_rms;
+  report.matrix_bytes = std::max(report.matrix_bytes, system->bytes() + solved.bytes);
+  fit.c = solved.c;
+  return fit;
+}
+
+// The fitted MLP's outputs at the data (N x outputs): A-SWIM's approximate target.
+ColMat fitted_outputs(const Fitted& fit) {
+  const Index w = fit.last_hidden.cols();
+  if (fit.c.cols() > 1) return fit.last_hidden * fit.c;  // the baseline: dx/dt
+  return fit.last_hidden * fit.c.col(0).reshaped(w, fit.c.rows() / w);
+}
+
+template <typename T>
+void write_weights(DynamicsModel<T>& model, const Fitted& fit) {
+  const auto hidden = Index(fit.layers.size());
+  const Index w = fit.layers.back().w.cols();
+  const ColMat last = fit.c.cols() > 1 ? fit.c : ColMat(fit.c.col(0).reshaped(w, fit.c.rows() / w));
+  model.visit_parameters([&](const std::string& name, ad::Var<T>& p) {
+    for (Index l = 0; l <= hidden; ++l) {
+      const std::string prefix = fmt::format("mlp.layers.{}.", l);
+      if (name == prefix + "weight") {
+        p.mutable_value() = (l < hidden ? fit.layers[std::size_t(l)].w : last).template cast<T>();
+      } else if (name == prefix + "bias" && l < hidden) {
+        p.mutable_value() = fit.layers[std::size_t(l)].b.template cast<T>();
+      }
+    }
+  });
+}
+
+}  // namespace
+
+template <typename T>
+SampledFitReport fit_sampled(DynamicsModel<T>& model, const Matrix<double>& x,
+                             const Matrix<double>& dxdt, const SampledFitConfig& config) {
+  const DynamicsConfig& mc = model.config();
+  check_inputs(mc, x, dxdt);
+  SampledFitReport report;
+  report.solver = std::string(name_of(kLeastSquaresSolverNames, config.solver));
+  const ColMat xc = x, dc = dxdt;
+  std::mt19937_64 rng(config.seed);
+  const bool adaptive = config.sampler == HiddenSampler::kAswim;
+  const bool baseline = mc.model == ModelKind::kBaseline;
+  Fitted fit = fit_once(mc, xc, dc, config, adaptive ? HiddenSampler::kUswim : config.sampler,
+                        nullptr, baseline || adaptive, rng, report);
+  if (adaptive) {
+    const ColMat approximate = fitted_outputs(fit);
+    fit = fit_once(mc, xc, dc, config, HiddenSampler::kAswim, &approximate, baseline, rng, report);
+  }
+  write_weights(model, fit);
+  return report;
+}
+
+template SampledFitReport fit_sampled<double>(DynamicsModel<double>&, const Matrix<double>&,
+                                              const Matrix<double>&, const SampledFitConfig&);
+template SampledFitReport fit_sampled<float>(DynamicsModel<float>&, const Matrix<double>&,
+                                             const Matrix<double>&, const SampledFitConfig&);
+
+}  // namespace hnn::nn

@@ -1,0 +1,85 @@
+#pragma once
+// Fitting a dynamics model without backpropagation (Rahma, Datar & Dietrich 2024, "Training
+// Hamiltonian neural networks without backpropagation", arXiv 2411.17511): every hidden layer
+// is sampled from the data (ELM: at random; SWIM: each neuron from a pair of data points), and
+// the last layer is the solution of a linear least-squares problem. This works because an HNN's
+// field (dH/dp, -dH/dq), a baseline's dx/dt and a D-HNN's two potentials are all linear in the
+// last layer's weights. An LNN's accelerations are not, so it is refused.
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+
+#include "nn/dynamics.h"
+#include "nn/enum_names.h"
+
+namespace hnn::nn {
+
+/// How hidden weights are drawn.
+enum class HiddenSampler {
+  kElm,    // random weights and biases (extreme learning machine)
+  kUswim,  // SWIM: each neuron from a pair of data points drawn uniformly
+  kAswim,  // SWIM with pairs weighted by how fast an approximate target (a U-SWIM fit) changes
+};
+inline constexpr NameTable<HiddenSampler, 3> kHiddenSamplerNames{{
+    {HiddenSampler::kElm, "elm"},
+    {HiddenSampler::kUswim, "uswim"},
+    {HiddenSampler::kAswim, "aswim"},
+}};
+
+/// How the last layer's least-squares problem is solved (docs/sampled.md has the measurements).
+enum class LeastSquaresSolver {
+  kLsqr,      // LSQR on A, right-preconditioned by the Cholesky factor of the regularised Gram,
+              // started from the normal equations' solution
+  kCholesky,  // the regularised normal equations (A^T A + lambda I) c = A^T b, by Cholesky
+  kQr,        // LAPACK's dgelsd (SVD-based, like np.linalg.lstsq) on the formed A: the reference
+};
+inline constexpr NameTable<LeastSquaresSolver, 3> kLeastSquaresSolverNames{{
+    {LeastSquaresSolver::kLsqr, "lsqr"},
+    {LeastSquaresSolver::kCholesky, "cholesky"},
+    {LeastSquaresSolver::kQr, "qr"},
+}};
+
+/// Settings of a sampled fit. The defaults reproduce the peer's accuracy (docs/sampled.md).
+struct SampledFitConfig {
+  HiddenSampler sampler = HiddenSampler::kUswim;
+  /// Singular values below rcond times the largest do not shape the solution (the peer's
+  /// np.linalg.lstsq rcond); each solver honours it in its own way (docs/sampled.md).
+  double rcond = 1e-13;
+  std::uint64_t seed = 0;
+  LeastSquaresSolver solver = LeastSquaresSolver::kLsqr;
+  /// lambda, added to the diagonal of A^T A after its columns are scaled to unit norm, for
+  /// kCholesky and kLsqr's preconditioner. When the Cholesky factorisation fails, lambda is
+  /// raised tenfold until it succeeds (at most to 1e-6; beyond, the system is called singular).
+  double regularization = 1e-13;
+  /// kLsqr stops when the normal-equation residual |A^T r| falls below tolerance * |A| |r|.
+  double tolerance = 1e-14;
+  /// kLsqr's iteration cap.
+  int max_iterations = 200;
+};
+
+/// What a fit did, for metrics.json and the closing figures.
+struct SampledFitReport {
+  std::string solver;            // the least-squares method that ran
+  double sample_seconds = 0;     // drawing the hidden layers
+  double assemble_seconds = 0;   // forming the matrices the solver reads
+  double solve_seconds = 0;      // the solve itself
+  double gram_seconds = 0;       // of assemble_seconds: A^T A (one syrk), or forming A for qr
+  double regularization = 0;     // the lambda the Cholesky factorisation took (kLsqr, kCholesky)
+  std::size_t rows = 0;          // equations of the least-squares problem
+  std::size_t columns = 0;       // unknowns (last-layer weights)
+  std::size_t matrix_bytes = 0;  // the largest matrices held at once
+  double residual_rms = 0;       // root mean square of the system's residual on the fit data
+  int iterations = 0;            // of an iterative solver; 0 for a direct one
+};
+
+/// Samples every hidden layer of `model` and solves its last layer so that model.field(x)
+/// approximates dxdt in the least-squares sense; the fit runs in double whatever T is. x and
+/// dxdt are N x dim, in the model's state coordinates. Throws std::invalid_argument, with one
+/// line naming what is wrong, for an LNN, a width the data cannot support, non-finite x or dxdt,
+/// or a singular system.
+template <typename T>
+SampledFitReport fit_sampled(DynamicsModel<T>& model, const Matrix<double>& x,
+                             const Matrix<double>& dxdt, const SampledFitConfig& config);
+
+}  // namespace hnn::nn

@@ -1,0 +1,113 @@
+#include "nn/sampled/systems.h"
+
+namespace hnn::nn::sampled {
+
+using Eigen::Index;
+
+void DenseSystem::gram(ColMat& g) const {
+  blas_gram(a_.data(), a_.rows(), a_.cols(), a_.rows(), g, 0);
+}
+
+void DenseSystem::apply(const ColMat& c, ColMat& out) const { blas_gemm(a_, false, c, false, out); }
+
+void DenseSystem::apply_t(const ColMat& r, ColMat& out) const {
+  blas_gemm(a_, true, r, false, out);
+}
+
+std::size_t DenseSystem::bytes() const {
+  return std::size_t(a_.size() + b_.size()) * sizeof(double);
+}
+
+HadamardSystem::HadamardSystem(ColMat d, ColMat v, const ColMat& dxdt)
+    : d_(std::move(d)), v_(std::move(v)), b_(dxdt.size(), 1) {
+  b_ = dxdt.reshaped();  // column-major: coordinate i's targets, then i + 1's
+  y_.resize(v_.rows(), d_.cols());
+  q_.resize(d_.cols(), v_.rows());
+  p_.resize(d_.rows(), v_.rows());
+}
+
+void HadamardSystem::gram(ColMat& g) const {
+  const Index w = d_.cols(), blocks = v_.cols() / w;
+  // D^T D into the first block; the others copy it before it is scaled.
+  ColMat k_block(0, 0);
+  ColMat* k = &g;
+  if (blocks > 1) {
+    k_block.resize(w, w);
+    k = &k_block;
+  }
+  blas_gram(d_.data(), d_.rows(), w, d_.rows(), *k, 0);
+  for (Index s = 0; s < blocks; ++s) {
+    for (Index t = 0; t < blocks; ++t) {
+      for (Index col = 0; col < w; ++col) {
+        for (Index row = 0; row < w; ++row) {
+          const double m = v_.col(s * w + row).dot(v_.col(t * w + col));
+          g(s * w + row, t * w + col) = (*k)(row, col) * m;
+        }
+      }
+    }
+  }
+}
+
+// A c: the field rows of coordinate i are D (sum_s v_is o c_s).
+void HadamardSystem::apply(const ColMat& c, ColMat& out) const {
+  const Index w = d_.cols(), blocks = v_.cols() / w, dim = v_.rows();
+  y_.setZero();
+  for (Index i = 0; i < dim; ++i) {
+    for (Index s = 0; s < blocks; ++s) {
+      y_.row(i).array() +=
+          v_.row(i).segment(s * w, w).array() * c.col(0).segment(s * w, w).transpose().array();
+    }
+  }
+  // D (Y^T)^T, not D Y: OpenBLAS 0.3.21's small-matrix kernel for a narrow right-hand side
+  // mallocs on every call (autodiff/gemm.h), and LSQR calls this every iteration.
+  blas_gemm(d_, false, y_, true, p_);
+  out.col(0) = Eigen::Map<const Eigen::VectorXd>(p_.data(), p_.size());
+}
+
+// A^T r: block s of the result is sum_i v_is o (D^T r_i).
+void HadamardSystem::apply_t(const ColMat& r, ColMat& out) const {
+  const Index w = d_.cols(), blocks = v_.cols() / w, dim = v_.rows();
+  p_ = Eigen::Map<const ColMat>(r.data(), d_.rows(), dim);
+  blas_gemm(d_, true, p_, false, q_);
+  out.setZero();
+  for (Index s = 0; s < blocks; ++s) {
+    for (Index i = 0; i < dim; ++i) {
+      out.col(0).segment(s * w, w).array() +=
+          v_.row(i).segment(s * w, w).transpose().array() * q_.col(i).array();
+    }
+  }
+}
+
+ColMat HadamardSystem::formed() const {
+  const Index n = d_.rows(), w = d_.cols(), blocks = v_.cols() / w, dim = v_.rows();
+  ColMat a(n * dim, v_.cols());
+  for (Index i = 0; i < dim; ++i) {
+    for (Index col = 0; col < blocks * w; ++col) {
+      a.col(col).segment(i * n, n) = d_.col(col % w) * v_(i, col);
+    }
+  }
+  return a;
+}
+
+void HadamardSystem::reduced(ColMat& a, ColMat& b) const {
+  const Index n = d_.rows(), w = d_.cols(), dim = v_.rows();
+  ColMat q = d_;
+  ColMat qtb = b_.reshaped(n, dim);
+  const ColMat r = qr_apply(q, qtb);
+  q = ColMat();
+  a.resize(dim * w, v_.cols());
+  b.resize(dim * w, 1);
+  for (Index i = 0; i < dim; ++i) {
+    for (Index col = 0; col < v_.cols(); ++col) {
+      a.col(col).segment(i * w, w) = r.col(col % w) * v_(i, col);
+    }
+    b.col(0).segment(i * w, w) = qtb.col(i).head(w);
+  }
+}
+
+std::size_t HadamardSystem::bytes() const {
+  return std::size_t(d_.size() + v_.size() + b_.size() + y_.size() + q_.size() + p_.size()) *
+         sizeof(double);
+}
+
+}  // namespace hnn::nn::sampled

@@ -1,0 +1,60 @@
+#include "tasks/fit_options.h"
+
+#include <utility>
+
+#include "tasks/error.h"
+#include "tasks/report/run_folder.h"
+
+namespace hnn::tasks {
+
+namespace fs = std::filesystem;
+
+// An LNN's accelerations come from inverting its Hessian in dq/dt: not linear in its last layer.
+void check_fit_model(const FitConfig& fit, nn::ModelKind model, const std::string& task) {
+  HNN_TASKS_CHECK(!fit.samples() || model != nn::ModelKind::kLnn,
+                  "{}: --fit {} does not fit an lnn: its accelerations are not linear in its last "
+                  "layer (they invert the Hessian of L in dq/dt), so no least-squares solve gives "
+                  "it (models it fits: hnn, baseline, dhnn)",
+                  task, fit.name());
+}
+
+// The options of Adam's steps, given with --fit sampled (which takes no steps): refused.
+void check_sampled_options(const RunOptions& o) {
+  const std::pair<bool, const char*> adam_options[] = {
+      {o.steps.has_value(), "--steps"},
+      {o.batch_size.has_value(), "--batch"},
+      {o.learning_rate.has_value(), "--lr"},
+      {o.lr_schedule.has_value(), "--lr-schedule"},
+      {o.weight_decay.has_value(), "weight decay"},
+      {o.checkpoint_every.has_value(), "--checkpoint-every"},
+      {o.resume, "--resume"}};
+  for (const auto& [given, name] : adam_options) {
+    HNN_TASKS_CHECK(!given,
+                    "{} does not apply to --fit sampled: it takes no training steps (the hidden "
+                    "layers are sampled, the last layer solved); --fit sampled+adam fine-tunes "
+                    "with Adam from there",
+                    name);
+  }
+}
+
+nlohmann::json recorded_fit(const fs::path& run_dir) {
+  const RunFolder folder(run_dir);
+  std::error_code ec;
+  if (!fs::exists(folder.file("metrics.json"), ec)) return nullptr;
+  return folder.read_metrics().value("fit", nlohmann::json());
+}
+
+void check_not_sampled_run(const fs::path& run_dir) {
+  const RunFolder folder(run_dir);
+  std::error_code ec;
+  if (fs::exists(folder.checkpoint_dir() / "state.json", ec)) return;
+  if (!fs::exists(folder.file("metrics.json"), ec)) return;
+  const nlohmann::json settings = folder.read_metrics().value("task_settings", nlohmann::json());
+  HNN_TASKS_CHECK(!settings.is_object() || settings.value("fit", "") != "sampled",
+                  "'{}' holds a run fitted with --fit sampled: it took no training steps, so "
+                  "there is nothing to resume or continue (train a new run with --fit "
+                  "sampled+adam --steps N to fine-tune with Adam)",
+                  run_dir.string());
+}
+
+}  // namespace hnn::tasks

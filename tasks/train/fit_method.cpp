@@ -1,0 +1,101 @@
+#include "tasks/train/fit_method.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "tasks/error.h"
+#include "tasks/report/json_values.h"
+
+namespace hnn::tasks {
+
+using nlohmann::json;
+
+namespace {
+
+// "solver_tolerance" -> "solver-tolerance": the option that sets a key.
+std::string option_name(std::string key) {
+  std::replace(key.begin(), key.end(), '_', '-');
+  return key;
+}
+
+void check_fraction(double value, const std::string& key, const std::string& task) {
+  HNN_TASKS_CHECK(value > 0 && value < 1, "{}: --{} must be in (0, 1), got {}", task,
+                  option_name(key), value);
+}
+
+}  // namespace
+
+std::vector<std::string> fit_method_names() { return nn::names_of(kFitMethodNames); }
+std::vector<std::string> sampler_names() { return nn::names_of(nn::kHiddenSamplerNames); }
+std::vector<std::string> solver_names() { return nn::names_of(nn::kLeastSquaresSolverNames); }
+
+const std::vector<std::string>& fit_setting_names() {
+  static const std::vector<std::string> names = {"fit",
+                                                 "sampler",
+                                                 "rcond",
+                                                 "solver",
+                                                 "regularization",
+                                                 "solver_tolerance",
+                                                 "solver_iterations"};
+  return names;
+}
+
+FitConfig fit_config(const json& s, const std::string& task) {
+  FitConfig c;
+  try {
+    if (s.contains("fit"))
+      c.method = nn::parse_name(kFitMethodNames, s["fit"].get<std::string>(), "fit method");
+    if (s.contains("sampler")) {
+      c.sampled.sampler =
+          nn::parse_name(nn::kHiddenSamplerNames, s["sampler"].get<std::string>(), "sampler");
+    }
+    if (s.contains("solver")) {
+      c.sampled.solver =
+          nn::parse_name(nn::kLeastSquaresSolverNames, s["solver"].get<std::string>(), "solver");
+    }
+    nn::SampledFitConfig& f = c.sampled;
+    f.rcond = s.value("rcond", f.rcond);
+    f.regularization = s.value("regularization", f.regularization);
+    f.tolerance = s.value("solver_tolerance", f.tolerance);
+    f.max_iterations = s.value("solver_iterations", f.max_iterations);
+  } catch (const std::exception& e) {
+    throw Error(fmt::format("{}: bad fit settings {}: {}", task, s.dump(), e.what()));
+  }
+  for (const std::string& key : fit_setting_names()) {
+    HNN_TASKS_CHECK(c.samples() || key == "fit" || !s.contains(key),
+                    "{}: --{} applies to a sampled fit only (add --fit sampled or --fit "
+                    "sampled+adam)",
+                    task, option_name(key));
+  }
+  check_fraction(c.sampled.rcond, "rcond", task);
+  check_fraction(c.sampled.tolerance, "solver_tolerance", task);
+  HNN_TASKS_CHECK(c.sampled.regularization > 0 && std::isfinite(c.sampled.regularization),
+                  "{}: --regularization must be a finite number > 0, got {}", task,
+                  c.sampled.regularization);
+  HNN_TASKS_CHECK(c.sampled.max_iterations >= 1,
+                  "{}: --solver-iterations must be at least 1, got {}", task,
+                  c.sampled.max_iterations);
+  return c;
+}
+
+json fit_report_json(const FitConfig& config, const nn::SampledFitReport& r) {
+  return {{"method", config.name()},
+          {"sampler", nn::name_of(nn::kHiddenSamplerNames, config.sampled.sampler)},
+          {"rcond", config.sampled.rcond},
+          {"solver", r.solver},
+          {"regularization", config.sampled.regularization},
+          {"regularization_used", r.regularization},
+          {"solver_tolerance", config.sampled.tolerance},
+          {"solver_iterations", config.sampled.max_iterations},
+          {"sample_seconds", r.sample_seconds},
+          {"assemble_seconds", r.assemble_seconds},
+          {"solve_seconds", r.solve_seconds},
+          {"gram_seconds", r.gram_seconds},
+          {"rows", r.rows},
+          {"columns", r.columns},
+          {"matrix_bytes", r.matrix_bytes},
+          {"residual_rms", number(r.residual_rms)},
+          {"iterations", r.iterations}};
+}
+
+}  // namespace hnn::tasks

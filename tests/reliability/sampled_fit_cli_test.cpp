@@ -1,0 +1,160 @@
+// `hnn train --fit sampled` (issue 29): hidden layers sampled, the last layer solved, no
+// backpropagation. A sampled run is an ordinary run folder: it evaluates, rolls out and exports;
+// its metrics.json says how the fit went; what does not apply to it is refused in one line
+// (the options themselves: cli_options_test.cpp).
+
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+
+#include "nn/sampled/sampled_fit.h"
+#include "reliability_util.h"
+
+namespace hnn::reliability {
+namespace {
+
+using nlohmann::json;
+
+// A small spring run: few evaluation rollouts keep it fast.
+Result train_spring(const TempDir& dir, const std::string& name, std::vector<std::string> extra) {
+  std::vector<std::string> args = {"train",      "spring",
+                                   "--hidden",   "100",
+                                   "--settings", R"({"rollouts": 3})",
+                                   "--out",      (dir / name).string()};
+  args.insert(args.end(), extra.begin(), extra.end());
+  return run_hnn(args, dir.path());
+}
+
+TEST(SampledFitCli, ASampledSpringHnnIsAnOrdinaryRunFolderThatKeepsTheEnergyAdvantage) {
+  const TempDir dir;
+  // The spring's dx/dt are noisy: with singular values below 1e-3 of the largest cut off, the
+  // learned H keeps closed level sets beyond the data (at the default 1e-13 its rollouts run
+  // away, the baseline's further still).
+  const std::vector<std::string> fit = {"--fit",   "sampled", "--solver", "qr",
+                                        "--rcond", "1e-3",    "--quiet"};
+  const Result hnn = train_spring(dir, "hnn", fit);
+  ASSERT_EQ(hnn.code, 0) << hnn.err;
+  std::vector<std::string> as_baseline = fit;
+  as_baseline.insert(as_baseline.end(), {"--model", "baseline"});
+  const Result baseline = train_spring(dir, "baseline", as_baseline);
+  ASSERT_EQ(baseline.code, 0) << baseline.err;
+  const json m = read_json(dir / "hnn" / "metrics.json");
+  // The fit's block, its time split and size; no steps and so no loss curve.
+  const json& report = m.at("fit");
+  EXPECT_EQ(report.at("method"), "sampled");
+  EXPECT_EQ(report.at("sampler"), "uswim");
+  EXPECT_FALSE(report.at("solver").get<std::string>().empty());
+  for (const char* key : {"sample_seconds", "assemble_seconds", "solve_seconds"})
+    EXPECT_GE(report.at(key).get<double>(), 0) << key;
+  EXPECT_EQ(report.at("columns").get<int>(), 100);
+  EXPECT_EQ(report.at("rows").get<int>(), 750 * 2);  // dH/dp and -dH/dq of each training state
+  EXPECT_GT(report.at("matrix_bytes").get<double>(), 0);
+  EXPECT_EQ(m.at("steps"), 0);
+  EXPECT_EQ(m.at("task_settings").at("fit"), "sampled");
+  EXPECT_GE(m.at("train_seconds").get<double>(),
+            report.at("sample_seconds").get<double>() + report.at("solve_seconds").get<double>());
+  EXPECT_FALSE(fs::exists(dir / "hnn" / "loss_curve.csv"));
+  EXPECT_FALSE(fs::exists(dir / "hnn" / "checkpoint"));
+  // The HNN's energy advantage over an equally sampled baseline.
+  const double baseline_energy =
+      read_json(dir / "baseline" / "metrics.json").at("energy_mse").get<double>();
+  EXPECT_LT(m.at("energy_mse").get<double>(), baseline_energy / 10);
+  // What the program says: a sampled fit, and how long each part took.
+  const Result shown = train_spring(dir, "shown", {"--fit", "sampled", "--sampler", "elm"});
+  ASSERT_EQ(shown.code, 0) << shown.err;
+  EXPECT_NE(shown.out.find("spring hnn: seed 0, sampled fit (elm), hidden 100"), std::string::npos)
+      << shown.out;
+  EXPECT_NE(shown.out.find("  fit        sampling "), std::string::npos) << shown.out;
+  // Evaluated again, rolled out and exported like any run.
+  const Result evaluated = run_hnn({"evaluate", (dir / "hnn").string()}, dir.path());
+  ASSERT_EQ(evaluated.code, 0) << evaluated.err;
+  EXPECT_NE(evaluated.out.find("sampled fit (uswim)"), std::string::npos) << evaluated.out;
+  ASSERT_EQ(run_hnn({"evaluate", (dir / "hnn").string(), "--json"}, dir.path()).code, 0);
+  const Result rollout = run_hnn(
+      {"rollout", (dir / "hnn").string(), "--out", (dir / "rollout.csv").string()}, dir.path());
+  EXPECT_EQ(rollout.code, 0) << rollout.err;
+  EXPECT_GT(lines(read_text(dir / "rollout.csv")).size(), 10u);
+  const Result exported = run_hnn(
+      {"export", (dir / "hnn").string(), "--format", "json", "--out", (dir / "h.json").string()},
+      dir.path());
+  EXPECT_EQ(exported.code, 0) << exported.err;
+  EXPECT_TRUE(fs::exists(dir / "h.json"));
+  // A fit that fails (too wide for the 750 training states) leaves the run it would replace.
+  const Result too_wide = train_spring(
+      dir, "hnn", {"--fit", "sampled", "--model", "baseline", "--hidden", "1000", "--force"});
+  EXPECT_EQ(too_wide.code, 1);
+  EXPECT_EQ(read_json(dir / "hnn" / "metrics.json"), m);
+  // No steps to resume or continue.
+  const Result resumed = run_hnn({"train", "--resume", (dir / "hnn").string()}, dir.path());
+  EXPECT_EQ(resumed.code, 1);
+  EXPECT_EQ(resumed.err, "hnn: error: '" + (dir / "hnn").string() +
+                             "' holds a run fitted with --fit sampled: it took no training steps, "
+                             "so there is nothing to resume or continue (train a new run with "
+                             "--fit sampled+adam --steps N to fine-tune with Adam)\n");
+}
+
+TEST(SampledFitCli, SampledThenAdamRunsItsStepsFromTheSampledWeights) {
+  const TempDir dir;
+  const Result r = train_spring(
+      dir, "run", {"--fit", "sampled+adam", "--steps", "20", "--lr", "1e-4", "--quiet"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const json m = read_json(dir / "run" / "metrics.json");
+  EXPECT_EQ(m.at("fit").at("method"), "sampled+adam");
+  EXPECT_EQ(m.at("steps"), 20);
+  const std::vector<std::string> curve = lines(read_text(dir / "run" / "loss_curve.csv"));
+  ASSERT_FALSE(curve.empty());
+  EXPECT_TRUE(curve.back().starts_with("20,")) << curve.back();
+  // From the sampled weights: the first recorded loss is already the sampled fit's, far below a
+  // fresh Adam run's after as many steps.
+  ASSERT_EQ(train_spring(dir, "adam", {"--steps", "20", "--lr", "1e-4", "--quiet"}).code, 0);
+  EXPECT_LT(m.at("test_loss").get<double>(),
+            read_json(dir / "adam" / "metrics.json").at("test_loss").get<double>() / 10);
+  // Continued with Adam from its checkpoint, not sampled again: the run keeps its fit's report.
+  const Result continued = run_hnn(
+      {"train", "--resume", (dir / "run").string(), "--steps", "30", "--quiet"}, dir.path());
+  ASSERT_EQ(continued.code, 0) << continued.err;
+  const json more = read_json(dir / "run" / "metrics.json");
+  EXPECT_EQ(more.at("steps"), 30);
+  EXPECT_EQ(more.at("fit"), m.at("fit"));
+  EXPECT_NE(continued.out.find("sampled fit (uswim), then Adam 30 steps"), std::string::npos)
+      << continued.out;
+}
+
+TEST(SampledFitCli, TheDataTaskFitsItsTrainingSplit) {
+  const TempDir dir;
+  const std::string csv = simulated_pendulum_csv(dir.path());
+  const Result r =
+      run_hnn({"train", "data", "--data", csv, "--coords", "q", "--momenta", "p", "--fit",
+               "sampled", "--hidden", "40", "--quiet", "--out", (dir / "run").string()},
+              dir.path());
+  ASSERT_EQ(r.code, 0) << r.err;
+  const json m = read_json(dir / "run" / "metrics.json");
+  EXPECT_EQ(m.at("fit").at("method"), "sampled");
+  EXPECT_LT(m.at("test_loss").get<double>(), 1e-2);
+}
+
+TEST(SampledFitCli, HelpShowsTheFitOptions) {
+  const TempDir dir;
+  const Result r = run_hnn({"train", "--help"}, dir.path());
+  ASSERT_EQ(r.code, 0);
+  EXPECT_NE(r.out.find("Training without backpropagation"), std::string::npos) << r.out;
+  for (const char* option : {"--fit", "--sampler", "--rcond", "--solver", "--regularization",
+                             "--solver-tolerance", "--solver-iterations"})
+    EXPECT_NE(r.out.find(std::string("  ") + option + " "), std::string::npos) << option;
+  // The defaults shown are the sampled fit's own (nn/sampled/sampled_fit.h).
+  const nn::SampledFitConfig defaults;
+  for (const auto& [option, value] : std::vector<std::pair<std::string, std::string>>{
+           {"--sampler", std::string(nn::name_of(nn::kHiddenSamplerNames, defaults.sampler))},
+           {"--solver", std::string(nn::name_of(nn::kLeastSquaresSolverNames, defaults.solver))},
+           {"--rcond", fmt::format("{:g}", defaults.rcond)},
+           {"--regularization", fmt::format("{:g}", defaults.regularization)},
+           {"--solver-tolerance", fmt::format("{:g}", defaults.tolerance)},
+           {"--solver-iterations", fmt::format("{}", defaults.max_iterations)}}) {
+    const std::size_t at = r.out.find("  " + option + " ");
+    ASSERT_NE(at, std::string::npos) << option;
+    const std::string line = r.out.substr(at, r.out.find('\n', at) - at);
+    EXPECT_NE(line.find("(default " + value + ")"), std::string::npos) << line;
+  }
+}
+
+}  // namespace
+}  // namespace hnn::reliability
