@@ -39,6 +39,9 @@ struct FitSpec {
   int horizon = 1;
   std::string integrator = "rk4";
   double dt = 0;
+  /// The fit's task settings, as `hnn train`'s ("fit", "sampler", "rcond", ...:
+  /// tasks/train/fit_method.h), a JSON object.
+  std::string fit = "{}";
 };
 
 class Model {

@@ -9,8 +9,11 @@
 #include "apps/python/arrays.h"
 #include "apps/python/interrupt.h"
 #include "apps/python/model.h"
+#include "nn/sampled/sampled_fit.h"
 #include "tasks/error.h"
+#include "tasks/fit_options.h"
 #include "tasks/train/field_objective.h"
+#include "tasks/train/fit_method.h"
 #include "tasks/train/loop.h"
 #include "tasks/train/rollout_objective.h"
 
@@ -96,6 +99,21 @@ py::array Model::fit(const py::handle& x, const py::handle& dxdt, const FitSpec&
     throw InputError(fmt::format("dxdt: expected {} rows, one per state of x, got {}",
                                  data.train_x.rows(), data.train_dxdt.rows()));
   check_spec(spec, data.train_x.rows(), "rows of x");
+  const tasks::FitConfig method = tasks::fit_config(nlohmann::json::parse(spec.fit), "fit");
+  if (method.samples()) {
+    tasks::check_fit_model(method, config().model, "fit");
+    nn::SampledFitConfig sampled = method.sampled;
+    sampled.seed = spec.seed;
+    double mse = 0;
+    {
+      py::gil_scoped_release free;
+      visit([&](auto& m) {
+        nn::fit_sampled(m, data.train_x, data.train_dxdt, sampled);
+        mse = tasks::field_mse(m, data.train_x, data.train_dxdt);
+      });
+    }
+    if (!method.steps()) return to_array(Eigen::VectorXd::Constant(1, mse));
+  }
   const nn::AdamOptions adam{.lr = spec.lr, .weight_decay = spec.weight_decay};
   return trained([&]<typename T>(nn::DynamicsModel<T>& m, tasks::StopSignal* stop) {
     Reporting<tasks::FieldObjective<T>> objective(m, data, spec.batch, adam, spec.seed);
@@ -129,7 +147,8 @@ void bind_model(py::module_& m) {
       .def_readwrite("callback", &FitSpec::callback)
       .def_readwrite("horizon", &FitSpec::horizon)
       .def_readwrite("integrator", &FitSpec::integrator)
-      .def_readwrite("dt", &FitSpec::dt);
+      .def_readwrite("dt", &FitSpec::dt)
+      .def_readwrite("fit", &FitSpec::fit);
   py::class_<Model>(m, "Model",
                     "A learned dynamics model: hnn.HNN, hnn.DHNN, hnn.Baseline, hnn.LNN.")
       .def(py::init([](const std::string& kind, long dim, std::vector<long> hidden,

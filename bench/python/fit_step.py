@@ -1,9 +1,11 @@
 """Seconds per training step: hnn.Model.fit from Python against the hnn program's own step on
-the same work (the spring task: 750 states, full batch, an HNN 2-200-200-1, float64, Adam, 2
-threads; float32 with a third argument float32), each measured by its own clock around the steps alone (metrics.json's train_seconds
-for the program). Alternates the two, prints each pair and the medians.
+the same work (the spring task: 750 states, full batch, an HNN 2-200-200-1, float64 or with a
+fourth argument float32, Adam, 2 threads), each measured by its own clock around the steps
+alone (metrics.json's train_seconds for the program). Alternates the two, prints each pair and
+the medians.
 
-  PYTHONPATH=build/apps/python /usr/bin/python3 bench/python/fit_step.py build/apps/hnn [STEPS] [PAIRS] [float32]
+  PYTHONPATH=build/apps/python /usr/bin/python3 bench/python/fit_step.py \
+      build/apps/hnn [STEPS] [PAIRS] [float32]
 """
 
 import json

@@ -53,6 +53,23 @@ class Models(unittest.TestCase):
                                steps=60, lr=1e-2, batch=32)
             self.assertLess(losses[-1], 0.2 * losses[0], integrator)
 
+    def test_sampled_fit_solves_without_steps(self):
+        x, dxdt = spring_data(400)
+        for make in (hnn.HNN, hnn.Baseline):
+            model = make(2, hidden=(100,), seed=0)
+            before = np.mean((model.vector_field(x) - dxdt) ** 2)
+            losses = model.fit(x, dxdt, fit="sampled", seed=1)
+            self.assertEqual(losses.shape, (1,))
+            self.assertAlmostEqual(losses[0], np.mean((model.vector_field(x) - dxdt) ** 2))
+            self.assertLess(losses[0], 1e-4 * before, make.__name__)
+        again = hnn.HNN(2, hidden=(100,), seed=0)
+        self.assertEqual(again.fit(x, dxdt, fit="sampled", seed=1)[0],
+                         hnn.HNN(2, hidden=(100,), seed=0).fit(x, dxdt, fit="sampled",
+                                                                seed=1)[0])
+        tuned = hnn.HNN(2, hidden=(100,), seed=0).fit(x, dxdt, fit="sampled+adam", steps=3,
+                                                       lr=1e-6, sampler="elm", solver="qr")
+        self.assertEqual(tuned.shape, (3,))
+
     def test_fit_is_seeded_and_batched(self):
         x, dxdt = spring_data()
         runs = [hnn.HNN(2, hidden=(8,), seed=0).fit(x, dxdt, steps=10, batch=16, seed=s,
@@ -278,6 +295,17 @@ class Errors(unittest.TestCase):
         self.expect("integrator 'euler'", self.model.fit, paths, t, loss="rollout",
                     integrator="euler")
         self.expect("loss must be derivative or rollout", self.model.fit, paths, t, loss="l2")
+        self.expect("fit: horizon is not taken with loss='derivative'", self.model.fit, x, dxdt,
+                    horizon=2)
+        self.expect("fit: unknown option 'stepz'", self.model.fit, x, dxdt, stepz=2)
+        self.expect("fit: steps is not taken with fit='sampled'", self.model.fit, x, dxdt,
+                    fit="sampled", steps=3)
+        self.expect("sampler applies to a sampled fit only", self.model.fit, x, dxdt,
+                    sampler="elm")
+        self.expect("unknown fit method 'magic'", self.model.fit, x, dxdt, fit="magic")
+        self.expect("does not fit an lnn", hnn.LNN(2, hidden=(4,)).fit, x, dxdt, fit="sampled")
+        self.expect("loss='rollout' trains with fit='adam' only", self.model.fit, paths, t,
+                    loss="rollout", fit="sampled")
         self.expect("unknown parameter 'w'", self.model.set_parameters, {"w": np.zeros((1, 1))})
 
     def test_bad_files(self):
@@ -368,6 +396,20 @@ class Programs(unittest.TestCase):
         np.testing.assert_array_equal(run.rollouts["true"]["x"], cli.rollouts["true"]["x"])
         evaluated = json.loads(run_hnn("evaluate", run.path, "--json", cwd=self.dir))
         self.assertEqual(evaluated["test_loss"], run.metrics["test_loss"])  # the program reads it
+
+    def test_train_with_a_sampled_fit_gives_the_programs_metrics(self):
+        args = ["--fit", "sampled", "--hidden", "64", "--sampler", "elm", "--quiet"]
+        run_hnn("train", "spring", "--out", "cli-sampled", *args, cwd=self.dir)
+        run = hnn.train("spring", out=os.path.join(self.dir, "py-sampled"), fit="sampled",
+                        hidden=64, sampler="elm", quiet=True)
+        cli = hnn.load_run(os.path.join(self.dir, "cli-sampled"))
+
+        def untimed(metrics):
+            out = {k: v for k, v in metrics.items() if not k.endswith("seconds")}
+            out["fit"] = {k: v for k, v in out["fit"].items() if not k.endswith("seconds")}
+            return out
+        self.assertEqual(run.metrics["fit"]["method"], "sampled")
+        self.assertEqual(untimed(run.metrics), untimed(cli.metrics))
 
     def test_a_model_saved_from_python_runs_in_the_program(self):
         # The run's own model, its weights changed from Python and saved into a copy of the run:
