@@ -149,12 +149,12 @@ void Model::set_parameters(const py::dict& values) {
     for (const auto& p : params) {
       if (!values.contains(p.name))
         throw InputError(fmt::format("set_parameters: '{}' is missing", p.name));
-      const py::handle value = values[py::str(p.name)];
-      Matrix<T> v = states<T>(value, p.name, p.var.cols());
-      if (v.rows() != p.var.rows())
-        throw InputError(fmt::format("set_parameters: '{}' must be {} x {}, got {} rows", p.name,
-                                     p.var.rows(), p.var.cols(), v.rows()));
-      checked.push_back(std::move(v));
+      const py::array value = py::array::ensure(values[py::str(p.name)]);
+      if (!value || value.ndim() != 2 || value.shape(0) != p.var.rows() ||
+          value.shape(1) != p.var.cols())
+        throw InputError(fmt::format("set_parameters: '{}' must be an array of {} x {}", p.name,
+                                     p.var.rows(), p.var.cols()));
+      checked.push_back(states<T>(value, "set_parameters: " + p.name, p.var.cols()));
     }
     for (std::size_t i = 0; i < params.size(); ++i) {
       ad::Var<T> leaf = params[i].var;

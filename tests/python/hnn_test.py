@@ -149,7 +149,7 @@ class Models(unittest.TestCase):
         bad = a.parameters()
         bad["mlp.layers.1.weight"] = np.zeros((3, 1))
         before = b.parameters()["mlp.layers.0.weight"].copy()
-        with self.assertRaisesRegex(hnn.Error, "mlp.layers.1.weight"):
+        with self.assertRaisesRegex(hnn.Error, "'mlp.layers.1.weight' must be an array of 4 x 1"):
             b.set_parameters({**bad, "mlp.layers.0.weight": np.ones((2, 4))})
         np.testing.assert_array_equal(b.parameters()["mlp.layers.0.weight"], before)
 
@@ -306,6 +306,10 @@ class Errors(unittest.TestCase):
         self.expect("does not fit an lnn", hnn.LNN(2, hidden=(4,)).fit, x, dxdt, fit="sampled")
         self.expect("loss='rollout' trains with fit='adam' only", self.model.fit, paths, t,
                     loss="rollout", fit="sampled")
+        params = self.model.parameters()
+        params["mlp.layers.0.bias"][0, 1] = np.nan
+        self.expect("set_parameters: mlp.layers.0.bias: NaN or infinity at row 0, column 1",
+                    self.model.set_parameters, params)
         self.expect("unknown parameter 'w'", self.model.set_parameters, {"w": np.zeros((1, 1))})
 
     def test_bad_files(self):
