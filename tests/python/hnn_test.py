@@ -413,6 +413,8 @@ class Programs(unittest.TestCase):
             out["fit"] = {k: v for k, v in out["fit"].items() if not k.endswith("seconds")}
             return out
         self.assertEqual(run.metrics["fit"]["method"], "sampled")
+        self.assertEqual(run.loss_curve, {})  # no steps, no loss_curve.csv
+        self.assertEqual(run.model.kind, "hnn")
         self.assertEqual(untimed(run.metrics), untimed(cli.metrics))
 
     def test_a_model_saved_from_python_runs_in_the_program(self):

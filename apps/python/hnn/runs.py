@@ -62,8 +62,12 @@ class Run:
     @property
     def loss_curve(self):
         """loss_curve.csv by column: {"step": [...], "train_loss": [...], "test_loss": [...]}
-        (the column names as the file has them)."""
-        with open(os.path.join(self.path, "loss_curve.csv"), newline="") as f:
+        (the column names as the file has them); empty for a run without one (a sampled fit
+        takes no steps)."""
+        path = os.path.join(self.path, "loss_curve.csv")
+        if not os.path.isfile(path):
+            return {}
+        with open(path, newline="") as f:
             rows = list(csv.reader(f))
         return {name: np.array([_number(r[i]) for r in rows[1:]])
                 for i, name in enumerate(rows[0])}
