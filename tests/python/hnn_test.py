@@ -72,7 +72,7 @@ class Models(unittest.TestCase):
 
     def test_fit_is_seeded_and_batched(self):
         x, dxdt = spring_data()
-        runs = [hnn.HNN(2, hidden=(8,), seed=0).fit(x, dxdt, steps=10, batch=16, seed=s,
+        runs = [hnn.HNN(2, hidden=8, seed=0).fit(x, dxdt, steps=10, batch=16, seed=s,
                                                      record_every=5) for s in (0, 0, 1)]
         self.assertEqual(runs[0].shape, (2,))
         np.testing.assert_array_equal(runs[0], runs[1])

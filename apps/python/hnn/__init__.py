@@ -16,7 +16,8 @@ __all__ = ["HNN", "DHNN", "Baseline", "LNN", "Model", "Error", "load", "train", 
 
 
 def _make(kind, dim, hidden, activation, dtype, seed, angles=0, kinetic_prior=1.0):
-    return Model(kind, int(dim), [int(w) for w in hidden], activation, dtype, int(seed),
+    widths = [hidden] if isinstance(hidden, int) else list(hidden)  # hidden=64: one layer
+    return Model(kind, int(dim), [int(w) for w in widths], activation, dtype, int(seed),
                  int(angles), float(kinetic_prior))
 
 
