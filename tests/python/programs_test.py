@@ -5,8 +5,10 @@ Run by ctest with PYTHONPATH at the built package (tests/CMakeLists.txt): python
 import csv
 import json
 import os
+import signal
 import subprocess
 import tempfile
+import threading
 import unittest
 
 import numpy as np
@@ -71,6 +73,18 @@ class Programs(unittest.TestCase):
         self.assertEqual(run.loss_curve, {})  # no steps, no loss_curve.csv
         self.assertEqual(run.model.kind, "hnn")
         self.assertEqual(untimed(run.metrics), untimed(cli.metrics))
+
+    def test_ctrl_c_stops_train_with_a_checkpoint_the_program_resumes(self):
+        out = os.path.join(self.dir, "stopped")
+        timer = threading.Timer(0.5, os.kill, (os.getpid(), signal.SIGINT))
+        timer.start()
+        with self.assertRaises(KeyboardInterrupt):
+            hnn.train("spring", out=out, steps=10**6, hidden=[4], quiet=True)
+        timer.join()
+        self.assertTrue(os.path.isdir(os.path.join(out, "checkpoint")))
+        self.assertFalse(os.path.exists(os.path.join(out, "metrics.json")))
+        with self.assertRaisesRegex(hnn.Error, "resume"):  # the program's own guard
+            hnn.train("spring", out=out, steps=10, quiet=True)
 
     def test_a_model_saved_from_python_runs_in_the_program(self):
         # The run's own model, its weights changed from Python and saved into a copy of the run:
