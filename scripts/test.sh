@@ -20,4 +20,9 @@ cmake -S examples/henon_heiles -B build/henon_heiles -DCMAKE_PREFIX_PATH="$root/
   >/dev/null
 cmake --build build/henon_heiles -j "$(nproc)" >/dev/null
 build/henon_heiles/henon_heiles
+# The Python package as installed (apps/python/CMakeLists.txt; README.md "From Python").
+for site in build/install/lib/python3*/dist-packages; do
+  [ ! -d "$site/hnn" ] || PYTHONPATH="$root/$site" /usr/bin/python3 -c \
+    'import hnn; hnn.HNN(2, hidden=(4,)).vector_field([[0.0, 1.0]])'
+done
 echo "test.sh: all tests passed"
