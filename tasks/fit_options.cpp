@@ -4,6 +4,7 @@
 
 #include "tasks/error.h"
 #include "tasks/report/run_folder.h"
+#include "tasks/train/checkpoint.h"
 
 namespace hnn::tasks {
 
@@ -18,8 +19,7 @@ void check_fit_model(const FitConfig& fit, nn::ModelKind model, const std::strin
                   task, fit.name());
 }
 
-// The options of Adam's steps, given with --fit sampled (which takes no steps): refused.
-void check_sampled_options(const RunOptions& o) {
+const char* adam_option_given(const RunOptions& o) {
   const std::pair<bool, const char*> adam_options[] = {
       {o.steps.has_value(), "--steps"},
       {o.batch_size.has_value(), "--batch"},
@@ -28,20 +28,29 @@ void check_sampled_options(const RunOptions& o) {
       {o.weight_decay.has_value(), "weight decay"},
       {o.checkpoint_every.has_value(), "--checkpoint-every"},
       {o.resume, "--resume"}};
-  for (const auto& [given, name] : adam_options) {
-    HNN_TASKS_CHECK(!given,
-                    "{} does not apply to --fit sampled: it takes no training steps (the hidden "
-                    "layers are sampled, the last layer solved); --fit sampled+adam fine-tunes "
-                    "with Adam from there",
-                    name);
-  }
+  for (const auto& [given, name] : adam_options)
+    if (given) return name;
+  return nullptr;
+}
+
+// The options of Adam's steps, given with --fit sampled (which takes no steps): refused.
+void check_sampled_options(const RunOptions& o) {
+  const char* name = adam_option_given(o);
+  HNN_TASKS_CHECK(name == nullptr,
+                  "{} does not apply to --fit sampled: it takes no training steps (the hidden "
+                  "layers are sampled, the last layer solved); --fit sampled+adam fine-tunes "
+                  "with Adam from there",
+                  name);
 }
 
 nlohmann::json recorded_fit(const fs::path& run_dir) {
   const RunFolder folder(run_dir);
   std::error_code ec;
-  if (!fs::exists(folder.file("metrics.json"), ec)) return nullptr;
-  return folder.read_metrics().value("fit", nlohmann::json());
+  if (fs::exists(folder.file("metrics.json"), ec))
+    return folder.read_metrics().value("fit", nlohmann::json());
+  // Interrupted before its metrics.json: its checkpoint carries the report (tasks/run.cpp).
+  if (!fs::exists(folder.checkpoint_dir() / "state.json", ec)) return nullptr;
+  return read_train_state(folder.checkpoint_dir()).run.value("fit", nlohmann::json());
 }
 
 void check_not_sampled_run(const fs::path& run_dir) {

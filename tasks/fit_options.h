@@ -13,14 +13,17 @@ namespace hnn::tasks {
 /// Throws Error for a sampled fit of an LNN, with the reason.
 void check_fit_model(const FitConfig& fit, nn::ModelKind model, const std::string& task);
 
+/// The first option of Adam's steps given in `o` (below), or nullptr.
+const char* adam_option_given(const RunOptions& o);
+
 /// Throws Error naming the first option of Adam's steps given in `o` (--steps, --batch, --lr,
 /// --lr-schedule, weight decay, --checkpoint-every, --resume): for a run fitted with --fit
 /// sampled, which takes none.
 void check_sampled_options(const RunOptions& o);
 
-/// metrics.json's "fit" in `run_dir` (how its weights were sampled and solved), or null: no
-/// metrics.json, or a run of Adam alone. What a run evaluated again or continued with Adam
-/// (which does not sample again) keeps.
+/// metrics.json's "fit" in `run_dir` (how its weights were sampled and solved), or, before its
+/// metrics.json, the one its checkpoint carries; null for a run of Adam alone, or no run. What a
+/// run evaluated again, resumed or continued with Adam (which does not sample again) keeps.
 nlohmann::json recorded_fit(const std::filesystem::path& run_dir);
 
 /// Throws Error when `run_dir` holds a run fitted with --fit sampled: it has no checkpoint, no

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <utility>
 
 #include "autodiff/parallel.h"
 #include "tasks/data/file_digest.h"
@@ -130,6 +131,15 @@ std::string some_entries(const fs::path& dir) {
   return fmt::format("{}", fmt::join(names, ", "));
 }
 
+// The run's folder, made (or, with --force, emptied) once nothing can fail before training.
+void make_run_folder(const RunOptions& o, const RunFolder& folder) {
+  if (o.force && !o.resume && fs::is_directory(o.out)) {
+    for (const fs::directory_entry& entry : fs::directory_iterator(o.out))
+      fs::remove_all(entry.path());
+  }
+  folder.create();
+}
+
 // The metrics of a trained run, with its settings: metrics.json's content.
 json run_metrics(const TaskRun& run, const RunFolder& folder, const TrainResult& trained,
                  const RunSettings& settings) {
@@ -238,18 +248,23 @@ json run_training(const RunOptions& o) {
   const double data_seconds = seconds_since(start);
   record_data_file(settings);
   const RunFolder folder(o.out);
-  const json sampled_before = o.resume ? recorded_fit(o.out) : json();  // not sampled again
-  // --fit sampled writes nothing while it runs: a fit that fails leaves the folder as it was.
-  const bool sampled_only = !settings.fit.steps();
-  TrainResult trained;
-  if (sampled_only) trained = run->train(loop_options(o, settings, folder));
-  // After the data (and a sampled fit): bad data leave the folder as it was, or no folder.
-  if (o.force && !o.resume && fs::is_directory(o.out)) {
-    for (const fs::directory_entry& entry : fs::directory_iterator(o.out))
-      fs::remove_all(entry.path());
-  }
-  folder.create();
-  if (!sampled_only) trained = run->train(loop_options(o, settings, folder));
+  LoopOptions loop = loop_options(o, settings, folder);
+  // Resumed, the weights come from the checkpoint (not sampled again): the run keeps its fit's
+  // report, from metrics.json or the checkpoint, and its next checkpoints carry it on.
+  const json sampled_before = o.resume ? recorded_fit(o.out) : json();
+  if (!sampled_before.is_null()) loop.run_settings["fit"] = sampled_before;
+  // After the data, and after a sampled fit's sampling (FieldTraining calls before_steps): bad
+  // data or a fit that fails (too wide, singular) leave the folder as it was, or no folder.
+  bool made = false;
+  const auto make_folder = [&] {
+    if (!std::exchange(made, true)) make_run_folder(o, folder);
+  };
+  if (settings.fit.samples() && !o.resume)
+    loop.before_steps = make_folder;
+  else
+    make_folder();
+  TrainResult trained = run->train(loop);
+  make_folder();  // where the task did not call before_steps
   if (trained.fit.is_null()) trained.fit = sampled_before;
   run->save(folder.params_file());
   json metrics = run_metrics(*run, folder, trained, settings);

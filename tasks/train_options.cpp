@@ -322,7 +322,7 @@ const TrainOption kOptions[] = {
      .kind = ValueKind::kChoice,
      .help = "The last layer's least-squares solver: lsqr (preconditioned iterations), cholesky "
              "(regularised normal equations) or qr (LAPACK's dgelsd, like numpy's lstsq) (default "
-             "lsqr)",
+             "qr)",
      .group = kFitGroup,
      .sweep_rank = 29,
      .applies_to = AppliesTo::kFieldTasks,

@@ -11,6 +11,7 @@
 #include "tasks/experiments/registry.h"
 #include "tasks/pixel/evaluation.h"
 #include "tasks/pixel/objective.h"
+#include "tasks/train/fit_method.h"
 #include "tasks/trained_model.h"
 
 namespace hnn::tasks {
@@ -173,6 +174,13 @@ class PixelPendulumTask : public Task {
                         "(--steps, --batch, --lr, --hidden), not a task setting",
                         key);
       }
+      const std::vector<std::string>& fit = fit_setting_names();
+      HNN_TASKS_CHECK(std::find(fit.begin(), fit.end(), key) == fit.end(),
+                      "pixel-pendulum: --{} does not apply: its model is an autoencoder and an HNN "
+                      "of its latent space trained together on frames, by Adam only (a sampled "
+                      "fit solves a field model's last layer on dx/dt targets, which frames do "
+                      "not give)",
+                      fit_option_name(key));
       HNN_TASKS_CHECK(std::find(known.begin(), known.end(), key) != known.end(),
                       "pixel-pendulum has no setting '{}' (known: {})", key,
                       fmt::join(known, ", "));

@@ -68,14 +68,23 @@ template <typename T>
 TrainResult FieldTraining::train(nn::DynamicsModel<T>& model, const Dataset& data,
                                  const RunSettings& s, const LoopOptions& loop) const {
   // Resumed, the checkpoint holds the weights: sampled + Adam samples only when it starts.
-  TrainResult sampled;
-  if (s.fit.samples() && !loop.resume) sampled = fit_by_sampling(model, data, s);
+  if (!s.fit.samples() || loop.resume) return train_steps(model, data, s, loop);
+  TrainResult sampled = fit_by_sampling(model, data, s);
+  if (loop.before_steps) loop.before_steps();
   if (!s.fit.steps()) return sampled;
-  TrainResult trained = loss_.rollout ? train_through_integrator(model, s, loop)
-                                      : train_model(model, data, s.train, s.seed, loop);
+  LoopOptions adam = loop;
+  adam.run_settings["fit"] = sampled.fit;  // its checkpoints carry the report
+  TrainResult trained = train_steps(model, data, s, adam);
   trained.seconds += sampled.seconds;
   trained.fit = std::move(sampled.fit);
   return trained;
+}
+
+template <typename T>
+TrainResult FieldTraining::train_steps(nn::DynamicsModel<T>& model, const Dataset& data,
+                                       const RunSettings& s, const LoopOptions& loop) const {
+  return loss_.rollout ? train_through_integrator(model, s, loop)
+                       : train_model(model, data, s.train, s.seed, loop);
 }
 
 template <typename T>

@@ -38,8 +38,8 @@ class FieldTraining {
 
   /// Trains `model` (fresh from the run's seed) on `data` or on the windows, with the loop's
   /// steps, schedule and record interval from `s.train`; with a sampled fit (s.fit), first
-  /// samples its hidden layers and solves its last layer on data's training split, and with
-  /// --fit sampled stops there.
+  /// samples its hidden layers and solves its last layer on data's training split (then calls
+  /// loop.before_steps), and with --fit sampled stops there.
   template <typename T>
   TrainResult train(nn::DynamicsModel<T>& model, const Dataset& data, const RunSettings& s,
                     const LoopOptions& loop) const;
@@ -53,6 +53,9 @@ class FieldTraining {
   }
 
  private:
+  template <typename T>
+  TrainResult train_steps(nn::DynamicsModel<T>& model, const Dataset& data, const RunSettings& s,
+                          const LoopOptions& loop) const;
   template <typename T>
   TrainResult train_through_integrator(nn::DynamicsModel<T>& model, const RunSettings& s,
                                        const LoopOptions& loop) const;

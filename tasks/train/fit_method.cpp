@@ -12,18 +12,17 @@ using nlohmann::json;
 
 namespace {
 
-// "solver_tolerance" -> "solver-tolerance": the option that sets a key.
-std::string option_name(std::string key) {
-  std::replace(key.begin(), key.end(), '_', '-');
-  return key;
-}
-
 void check_fraction(double value, const std::string& key, const std::string& task) {
   HNN_TASKS_CHECK(value > 0 && value < 1, "{}: --{} must be in (0, 1), got {}", task,
-                  option_name(key), value);
+                  fit_option_name(key), value);
 }
 
 }  // namespace
+
+std::string fit_option_name(std::string key) {
+  std::replace(key.begin(), key.end(), '_', '-');
+  return key;
+}
 
 std::vector<std::string> fit_method_names() { return nn::names_of(kFitMethodNames); }
 std::vector<std::string> sampler_names() { return nn::names_of(nn::kHiddenSamplerNames); }
@@ -65,7 +64,7 @@ FitConfig fit_config(const json& s, const std::string& task) {
     HNN_TASKS_CHECK(c.samples() || key == "fit" || !s.contains(key),
                     "{}: --{} applies to a sampled fit only (add --fit sampled or --fit "
                     "sampled+adam)",
-                    task, option_name(key));
+                    task, fit_option_name(key));
   }
   check_fraction(c.sampled.rcond, "rcond", task);
   check_fraction(c.sampled.tolerance, "solver_tolerance", task);

@@ -42,6 +42,8 @@ struct FitConfig {
 /// without a sampled fit.
 FitConfig fit_config(const nlohmann::json& settings, const std::string& task);
 const std::vector<std::string>& fit_setting_names();
+/// "solver_tolerance" -> "solver-tolerance": the option that sets a key of fit_setting_names().
+std::string fit_option_name(std::string key);
 
 /// metrics.json's "fit": the method, the sampler and what the fit did (`report`).
 nlohmann::json fit_report_json(const FitConfig& config, const nn::SampledFitReport& report);

@@ -55,8 +55,13 @@ struct LoopOptions {
   /// With resume: the steps of the finished run the checkpoint is of, when this run goes on past
   /// them to `steps` (0: the checkpoint is of a run of `steps`).
   long checkpoint_steps = 0;
-  /// The run's settings, stored in every checkpoint (for `hnn train --resume`).
+  /// The run's settings, stored in every checkpoint (for `hnn train --resume`); with a sampled
+  /// fit, its report under "fit" (what the run keeps when resumed).
   nlohmann::json run_settings{};
+  /// Called once by a run that samples its hidden layers first (FieldTraining), after sampling
+  /// and before anything is written: the run folder is made there, so that a fit that fails
+  /// leaves none (tasks/run.cpp).
+  std::function<void()> before_steps{};
   /// Polled after every step: when requested, training checkpoints and throws
   /// TrainingInterrupted.
   StopSignal* stop = nullptr;

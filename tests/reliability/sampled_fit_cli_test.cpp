@@ -8,6 +8,9 @@
 
 #include "nn/sampled/sampled_fit.h"
 #include "reliability_util.h"
+#include "tasks/fit_options.h"
+#include "tasks/run.h"
+#include "tasks/train/stop.h"
 
 namespace hnn::reliability {
 namespace {
@@ -117,6 +120,67 @@ TEST(SampledFitCli, SampledThenAdamRunsItsStepsFromTheSampledWeights) {
   EXPECT_EQ(more.at("fit"), m.at("fit"));
   EXPECT_NE(continued.out.find("sampled fit (uswim), then Adam 30 steps"), std::string::npos)
       << continued.out;
+}
+
+TEST(SampledFitCli, AnInterruptedSampledThenAdamRunKeepsItsFitWhenResumed) {
+  const TempDir dir;
+  tasks::RunOptions o;
+  o.task = "spring";
+  o.hidden = std::vector<int>{100};
+  o.steps = 20;
+  o.learning_rate = 1e-4;
+  o.task_settings = {{"rollouts", 3}, {"fit", "sampled+adam"}};
+  o.quiet = true;
+  o.out = dir / "run";
+  tasks::StopSignal stop;
+  stop.requested = true;  // stops after step 1, checkpointed, before metrics.json
+  o.stop = &stop;
+  EXPECT_THROW(tasks::run_training(o), tasks::TrainingInterrupted);
+  ASSERT_FALSE(fs::exists(dir / "run" / "metrics.json"));
+  const json report = tasks::recorded_fit(dir / "run");  // from the checkpoint
+  ASSERT_TRUE(report.is_object()) << report.dump();
+  EXPECT_EQ(report.at("method"), "sampled+adam");
+  const Result resumed =
+      run_hnn({"train", "--resume", (dir / "run").string(), "--quiet"}, dir.path());
+  ASSERT_EQ(resumed.code, 0) << resumed.err;
+  const json m = read_json(dir / "run" / "metrics.json");
+  EXPECT_EQ(m.at("steps"), 20);
+  EXPECT_EQ(m.at("fit"), report);
+}
+
+TEST(SampledFitCli, ASampledThenAdamFitThatFailsWritesNothing) {
+  const TempDir dir;
+  // Too wide for the 750 training states: the sampling fails before the folder is made.
+  const std::vector<std::string> too_wide = {"--fit",    "sampled+adam", "--model", "baseline",
+                                             "--hidden", "1000",         "--steps", "5"};
+  const Result fresh = train_spring(dir, "new", too_wide);
+  EXPECT_EQ(fresh.code, 1);
+  EXPECT_FALSE(fs::exists(dir / "new"));
+  // Nor is a run it would replace with --force removed.
+  ASSERT_EQ(train_spring(dir, "old", {"--steps", "5", "--quiet"}).code, 0);
+  const json before = read_json(dir / "old" / "metrics.json");
+  std::vector<std::string> forced = too_wide;
+  forced.push_back("--force");
+  const Result replaced = train_spring(dir, "old", forced);
+  EXPECT_EQ(replaced.code, 1);
+  EXPECT_EQ(read_json(dir / "old" / "metrics.json"), before);
+  EXPECT_TRUE(fs::exists(dir / "old" / "params.bin"));
+}
+
+TEST(SampledFitCli, ThePixelPendulumSaysWhyItTakesNoFit) {
+  const TempDir dir;
+  for (const std::vector<std::string> option :
+       {std::vector<std::string>{"--fit", "sampled"}, {"--solver-tolerance", "1e-10"}}) {
+    std::vector<std::string> args = {"train", "pixel-pendulum", "--out", (dir / "run").string()};
+    args.insert(args.end(), option.begin(), option.end());
+    const Result r = run_hnn(args, dir.path());
+    EXPECT_EQ(r.code, 1);
+    EXPECT_EQ(r.err, "hnn: error: pixel-pendulum: " + option[0] +
+                         " does not apply: its model is an autoencoder and an HNN of its latent "
+                         "space trained together on frames, by Adam only (a sampled fit solves a "
+                         "field model's last layer on dx/dt targets, which frames do not give)\n");
+    EXPECT_FALSE(fs::exists(dir / "run"));
+  }
 }
 
 TEST(SampledFitCli, TheDataTaskFitsItsTrainingSplit) {

@@ -65,6 +65,8 @@ class Options(CompareCase):
             (["--tasks", "spring", "--loss", "energy"], ["unknown loss 'energy'", "derivative"]),
             (["--tasks", "spring", "--steps", "0"], ["--steps", "expected an integer >= 1"]),
             (["--tasks", "spring", "--scheduler", "localhost"], ["tcp://HOST:8786"]),
+            (["--tasks", "spring", "--fit", "adam,sgd"], ["--fit: unknown fit 'sgd'",
+                                                          "known: adam, sampled, sampled+adam"]),
         ]
         for args, needles in cases:
             with self.subTest(args=args):
@@ -101,6 +103,24 @@ class Options(CompareCase):
         runs = sum(int(l.split(": ")[1].split()[0]) for l in lines if l.endswith(" runs"))
         self.assertEqual(len(commands), runs)
         self.assertGreaterEqual(runs, 6)  # pixel-pendulum hnn, spring dhnn and hnn: 2 seeds each
+        self.assertFalse(os.path.exists(self.out))
+
+    def test_the_fit_is_an_axis_and_a_sampled_row_takes_no_steps(self):
+        result = hnn("compare", "--tasks", "spring,double-pendulum", "--models", "hnn,lnn",
+                     "--fit", "adam,sampled", "--seeds", "2", "--steps", "50", "--list",
+                     "--out", self.out)
+        self.assertEqual(result.returncode, 0, result.stderr)
+        lines = result.stdout.splitlines()
+        self.assertIn("spring hnn derivative: 2 runs", lines)
+        self.assertIn("spring hnn (sampled) derivative: 2 runs", lines)
+        lnn = [l for l in lines if l.startswith("double-pendulum lnn (sampled) derivative: ")]
+        self.assertEqual(len(lnn), 1, lines)
+        self.assertIn("skipped: double-pendulum: --fit sampled does not fit an lnn", lnn[0])
+        spring = [l for l in lines if l.startswith("hnn train spring --model hnn ")]
+        sampled = [l for l in spring if "--fit sampled" in l]
+        self.assertEqual(len(sampled), 2)
+        self.assertTrue(all("--steps" not in l for l in sampled), sampled)
+        self.assertTrue(all("--steps 50" in l for l in spring if l not in sampled), spring)
         self.assertFalse(os.path.exists(self.out))
 
     def test_the_default_study_says_why_a_family_hnn_lacks_is_skipped(self):
@@ -176,6 +196,12 @@ class Report(unittest.TestCase):
                                            {"dhnn"})
         self.assertIn("options", why)
         self.assertEqual(self.report.row_label(row)[0], "data real_pend_h_1.txt")
+
+    def test_a_fit_other_than_adam_is_named_in_the_model_column(self):
+        self.assertEqual(self.report.model_label({"model": "hnn", "fit": "sampled"}),
+                         "hnn (sampled)")
+        self.assertEqual(self.report.model_label({"model": "hnn", "fit": "adam"}), "hnn")
+        self.assertEqual(self.report.model_label({"model": "hnn"}), "hnn")  # an older plan
 
     def test_the_row_label_shows_the_protocol(self):
         task, loss = self.report.row_label(self.row({"setup": "srnn"}, horizon=4))

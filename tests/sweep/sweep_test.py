@@ -7,6 +7,7 @@ the middle of a run, and checks that every run finishes once with the metrics of
 trained one at a time by `hnn train`. The others: bad specs, the lock, --emit slurm, a run's own
 failure on a local cluster, and the shipped specs against the runs they replace."""
 
+import csv
 import fcntl
 import json
 import os
@@ -114,6 +115,9 @@ class SpecErrors(SweepCase):
         ("task: [spring]\n  seed: [0\n", "yaml", "not valid YAML"),
         ('{"task": ["spring"], "settings": [{"trials": 3}]}', "json",
          "run 'spring/hnn/settings=trials-3': task 'spring' has no setting 'trials'"),
+        ('{"task": ["spring"], "fit": ["adam", "sampled"], "steps": [10]}', "json",
+         "run 'spring/hnn/steps=10,fit=sampled': --steps does not apply to --fit sampled (it "
+         "takes no training steps): put the sampled runs in a grid of their own, without --steps"),
     ]
 
     def test_each_bad_spec_is_one_line_naming_its_key(self):
@@ -395,6 +399,39 @@ class Charts(unittest.TestCase):
         self.assertAlmostEqual(ey, 1.0)
         self.assertEqual(points[0][2:4], (0.0, 0.0))  # one seed: no error bar
 
+    def test_the_fit_block_has_columns_of_its_own_beside_the_fit_key(self):
+        # results.csv: the spec's `fit` (the fit asked for) and metrics.json's "fit" block (how
+        # it went) both readable, the block flattened to fit_* columns; results.json keeps both.
+        sys.path.insert(0, os.path.join(SOURCE, "apps", "hnn", "sweep"))
+        import sweep_report
+        out = tempfile.mkdtemp(prefix="hnn-sweep-table-")
+        self.addCleanup(shutil.rmtree, out, ignore_errors=True)
+        block = {"method": "sampled", "solver": "qr", "solve_seconds": 0.25}
+        runs = {"spring/hnn/fit=sampled": {"test_loss": 1e-4, "fit": block},
+                "spring/hnn/fit=adam": {"test_loss": 1e-3}}
+        for name, metrics in runs.items():
+            os.makedirs(os.path.join(out, "runs", name))
+            write(os.path.join(out, "runs", name, "metrics.json"), json.dumps(metrics))
+        plan = {"spec": "s.yaml", "out": out, "keys": ["task", "fit"],
+                "runs": [{"name": n, "values": {"task": "spring", "fit": n.split("=")[1]}}
+                         for n in runs]}
+        rows = sweep_report.write_table(plan)
+        with open(os.path.join(out, "results.csv")) as f:
+            table = list(csv.DictReader(f))
+        self.assertEqual([r["fit"] for r in table], ["sampled", "adam"])
+        self.assertEqual([r["fit_method"] for r in table], ["sampled", ""])
+        self.assertEqual([r["fit_solver"] for r in table], ["qr", ""])
+        self.assertEqual(table[0]["fit_solve_seconds"], "0.25")
+        self.assertEqual(read_json(os.path.join(out, "results.json"))["runs"][0]["metrics"]["fit"],
+                         block)
+        # A chart may name a column of the block.
+        plan["charts"] = [{"x_metric": "fit_solve_seconds", "y": "test_loss", "file": "c.png"}]
+        try:
+            import matplotlib  # noqa: F401
+        except ImportError:
+            return
+        self.assertEqual(sweep_report.write_charts(plan, rows), [os.path.join(out, "c.png")])
+
 
 class Expansion(SweepCase):
     """How a spec becomes runs: hnn train's arguments, folder names, grids, duplicates."""
@@ -502,6 +539,33 @@ class ShippedSpecs(SweepCase):
         self.assertEqual(len(new_runs), 124)
         self.assertEqual(len(set(new_runs)), 124)
         self.assertEqual(set(new_runs), expected)
+
+    def test_sampled_is_adam_at_the_defaults_and_sampled_at_several_widths(self):
+        # Issue 29's speed against accuracy: Adam at each task's defaults, the sampled fit at
+        # widths each task's data can support; seeds 0-2; the sampled runs take no steps.
+        seeds = ("0", "1", "2")
+        paper = ("spring", "pendulum", "two-body")
+        expected = {(t, m, "double", "", s, ("--fit",)) for t in paper
+                    for m in ("hnn", "baseline") for s in seeds}
+        expected |= {(t, m, "double", w, s, ("--fit", "--rcond", "--solver"))
+                     for t in ("spring", "pendulum") for m in ("hnn", "baseline") for s in seeds
+                     for w in ("25", "50", "100", "200", "400", "700")}
+        expected |= {("two-body", m, "double", w, s, ("--fit",)) for m in ("hnn", "baseline")
+                     for s in seeds for w in ("100", "200", "400", "800", "1600")}
+        expected |= {("pendulum-scattered", "hnn", "double", "", s, ("--steps", "--fit"))
+                     for s in seeds}
+        expected |= {("pendulum-scattered", "hnn", "double", w, s, ("--fit",)) for s in seeds
+                     for w in ("100", "200", "400", "1000")}
+        listed = hnn("sweep", os.path.join(SOURCE, "sweeps", "sampled.yaml"), "--out",
+                     self.path("new"), "--list")
+        self.assertEqual(listed.returncode, 0, listed.stderr)
+        lines = listed.stdout.splitlines()
+        runs = self.runs_of(lines)
+        self.assertEqual(len(runs), 135)
+        self.assertEqual(set(runs), expected)
+        for line in lines:
+            if "--fit sampled" in line and "train spring" in line:
+                self.assertIn("--rcond 0.001 --solver qr", line)
 
     def test_table1_is_the_runs_of_hnn_reproduce(self):
         # reproduce's own list of its tasks, from its refusal of another.

@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <cstdlib>
 #include <fstream>
 #include <set>
@@ -21,6 +22,7 @@
 #include "tasks/experiments/registry.h"
 #include "tasks/studies/published.h"
 #include "tasks/task.h"
+#include "tasks/train/fit_method.h"
 
 namespace hnn::app {
 
@@ -34,7 +36,7 @@ using nlohmann::ordered_json;
 constexpr int kQuickSteps = 100;
 
 struct CompareOptions {
-  std::vector<std::string> tasks, models, losses;
+  std::vector<std::string> tasks, models, losses, fits;
   int seeds = 3, steps = 0;
   std::string out;
   bool quick = false, list = false;
@@ -99,7 +101,7 @@ std::vector<Group> default_study() {
 // One row of the table: a (task, model, loss) at its protocol's keys, and its runs, or why it
 // does not run.
 struct Row {
-  std::string task, model, loss;
+  std::string task, model, loss, fit;
   ordered_json keys = ordered_json::object();
   std::string headline;
   std::vector<std::string> metrics;
@@ -143,7 +145,15 @@ std::vector<Group> study(const CompareOptions& o) {
   return groups;
 }
 
-// The sweep spec of one row: its task, model and loss, and the seeds (and steps) of the study.
+// The sweep keys of Adam's steps (tasks/fit_options.h, adam_option_given): a protocol's, left
+// out of a row fitted by sampling alone, which takes no steps.
+constexpr std::array<const char*, 5> kAdamKeys = {"steps", "batch", "lr", "lr-schedule",
+                                                  "checkpoint-every"};
+
+bool takes_steps(const std::string& fit) { return fit != "sampled"; }
+
+// The sweep spec of one row: its task, model, loss and fit, and the seeds (and steps) of the
+// study.
 ordered_json row_spec(const Row& row, const CompareOptions& o) {
   ordered_json spec = ordered_json::object();
   spec["task"] = {row.task};
@@ -152,8 +162,9 @@ ordered_json row_spec(const Row& row, const CompareOptions& o) {
   for (int s = 0; s < o.seeds; ++s) seeds.push_back(static_cast<unsigned long long>(s));
   spec["seed"] = seeds;
   for (const auto& [key, value] : row.keys.items()) spec[key] = ordered_json::array({value});
-  if (o.steps > 0) spec["steps"] = {o.steps};               // over the protocol's own
+  if (o.steps > 0 && takes_steps(row.fit)) spec["steps"] = {o.steps};  // over the protocol's
   if (row.loss != "derivative") spec["loss"] = {row.loss};  // derivative: hnn train's default
+  if (row.fit != "adam") spec["fit"] = {row.fit};           // adam: hnn train's default
   return spec;
 }
 
@@ -202,19 +213,28 @@ sweep::SweepPlan expand_rows(std::vector<Row>& rows, const CompareOptions& o, co
   return plan;
 }
 
-std::vector<Row> rows_of(const std::vector<Group>& groups) {
+// Each group's rows, for each fit (a fit's rows after the previous fit's).
+std::vector<Row> rows_of(const std::vector<Group>& groups, const std::vector<std::string>& fits) {
   std::vector<Row> rows;
   std::set<std::string> seen;
-  for (const Group& g : groups)
-    for (const std::string& t : g.tasks)
-      for (const std::string& m : g.models)
-        for (const std::string& l : g.losses) {
-          if (!seen.insert(t + "\n" + m + "\n" + l).second) continue;
-          Row row{t, m, l, g.keys, g.headline, g.metrics, "", {}};
-          if (l == "rollout") row.keys.update(g.rollout_keys);
-          rows.push_back(std::move(row));
-        }
+  for (const std::string& f : fits)
+    for (const Group& g : groups)
+      for (const std::string& t : g.tasks)
+        for (const std::string& m : g.models)
+          for (const std::string& l : g.losses) {
+            if (!seen.insert(t + "\n" + m + "\n" + l + "\n" + f).second) continue;
+            Row row{t, m, l, f, g.keys, g.headline, g.metrics, "", {}};
+            if (l == "rollout") row.keys.update(g.rollout_keys);
+            if (!takes_steps(f))
+              for (const char* key : kAdamKeys) row.keys.erase(key);
+            rows.push_back(std::move(row));
+          }
   return rows;
+}
+
+// "hnn", or "hnn (sampled)" for a fit other than Adam.
+std::string model_label(const Row& r) {
+  return r.fit == "adam" ? r.model : fmt::format("{} ({})", r.model, r.fit);
 }
 
 json rows_json(const std::vector<Row>& rows) {
@@ -223,6 +243,7 @@ json rows_json(const std::vector<Row>& rows) {
     out.push_back({{"task", r.task},
                    {"model", r.model},
                    {"loss", r.loss},
+                   {"fit", r.fit},
                    {"keys", json::parse(r.keys.dump())},
                    {"headline", r.headline.empty() ? json(nullptr) : json(r.headline)},
                    {"metrics", r.metrics},
@@ -263,9 +284,9 @@ void list_rows(const std::vector<Row>& rows) {
   for (const Row& r : rows) {
     const std::string keys = r.keys.empty() ? "" : " " + r.keys.dump();
     if (r.skipped.empty())
-      fmt::print("{} {} {}{}: {} runs\n", r.task, r.model, r.loss, keys, r.runs.size());
+      fmt::print("{} {} {}{}: {} runs\n", r.task, model_label(r), r.loss, keys, r.runs.size());
     else
-      fmt::print("{} {} {}{}: skipped: {}\n", r.task, r.model, r.loss, keys, r.skipped);
+      fmt::print("{} {} {}{}: skipped: {}\n", r.task, model_label(r), r.loss, keys, r.skipped);
   }
 }
 
@@ -273,10 +294,12 @@ void run_compare(CompareOptions o) {
   check_names(o.tasks, tasks::task_names(), "--tasks", "task");
   check_names(o.models, tasks::model_names(), "--models", "model");
   check_names(o.losses, tasks::loss_names(), "--loss", "loss");
+  check_names(o.fits, tasks::fit_method_names(), "--fit", "fit");
+  if (o.fits.empty()) o.fits = {"adam"};
   sweep::check_scheduler(o.launch.scheduler);
   if (o.quick && o.steps == 0) o.steps = kQuickSteps;
   const fs::path out = fs::absolute(o.out).lexically_normal();
-  std::vector<Row> rows = rows_of(study(o));
+  std::vector<Row> rows = rows_of(study(o), o.fits);
   if (o.steps > 0) {
     for (Row& row : rows) row.keys.erase("steps");  // --steps is every run's
   }
@@ -314,6 +337,11 @@ void add_compare_command(CLI::App& app, int argc, char** argv) {
                   "Comma-separated model families (default: every one hnn has)")
       ->delimiter(',');
   cmd->add_option("--loss", o->losses, "Comma-separated losses: derivative, rollout")
+      ->delimiter(',');
+  cmd->add_option("--fit", o->fits,
+                  "Comma-separated fits, an axis of the study: adam, sampled, sampled+adam "
+                  "(default adam; a sampled row takes no steps, and the table names it like "
+                  "'hnn (sampled)')")
       ->delimiter(',');
   cmd->add_option("--seeds", o->seeds, "Seeds per task, model and loss (0..N-1)")
       ->check(integer_in(1, 1000))

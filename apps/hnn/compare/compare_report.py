@@ -94,10 +94,11 @@ def summarise(row, by_run):
     runs = [by_run[name] for name in row["runs"] if name in by_run]
     done = [r for r in runs if r["status"] == "done"]
     failed = [{"run": r["run"], "reason": r["reason"]} for r in runs if r["status"] == "failed"]
-    keys = sorted({k for r in done for k, v in r["metrics"].items() if is_number(v)})
+    flat = [sweep_report.table_metrics(r["metrics"]) for r in done]  # fit_solve_seconds, ...
+    keys = sorted({k for m in flat for k, v in m.items() if is_number(v)})
     metrics = {}
     for k in keys:
-        values = [r["metrics"][k] for r in done if is_number(r["metrics"].get(k))]
+        values = [m[k] for m in flat if is_number(m.get(k))]
         m, se = mean_se(values)
         metrics[k] = {"mean": m, "se": se, "n": len(values)}
     if row["skipped"]:
@@ -156,6 +157,12 @@ def unmatched_reason(peer, section, rows, hnn_tasks, models_run):
     return f"loss '{peer.get('loss') or 'derivative'}' not in this comparison"
 
 
+def model_label(row):
+    """The model column: the family, and the fit where it is not Adam ("hnn (sampled)")."""
+    fit = row.get("fit", "adam")
+    return row["model"] if fit == "adam" else f"{row['model']} ({fit})"
+
+
 def build(plan, table):
     section = plan["compare"]
     by_run = {r["run"]: r for r in table}
@@ -164,7 +171,8 @@ def build(plan, table):
     for row in section["rows"]:
         status, done, failed, metrics = summarise(row, by_run)
         mine = [p for p in peers if peer_matches(p, row)] if not row["skipped"] else []
-        rows.append({"task": row["task"], "model": row["model"], "loss": row["loss"],
+        rows.append({"task": row["task"], "model": model_label(row), "loss": row["loss"],
+                     "fit": row.get("fit", "adam"),
                      "keys": row.get("keys") or {}, "status": status, "skipped": row["skipped"], "runs": row["runs"],
                      "seeds_done": done, "failed": failed,
                      "headline": headline_of(section, row), "metrics": metrics,

@@ -50,6 +50,19 @@ def cell(value):
     return str(value)
 
 
+def table_metrics(metrics):
+    """A run's metrics.json as table columns: its "fit" block (how a sampled fit went) flattened
+    to fit_method, fit_sampler, fit_solve_seconds, ..., so that it stands apart from the spec's
+    `fit` key (the fit asked for) and each of its figures is a column of its own."""
+    flat = {k: v for k, v in metrics.items() if k != "fit"}
+    fit = metrics.get("fit")
+    if isinstance(fit, dict):
+        flat.update({f"fit_{k}": v for k, v in fit.items()})
+    elif fit is not None:
+        flat["fit_report"] = fit
+    return flat
+
+
 def write_table(plan):
     """OUT/results.json and OUT/results.csv: one row per run of the plan, in its order, with the
     spec's values, the run's state and its metrics.json. Returns the JSON rows."""
@@ -68,14 +81,13 @@ def write_table(plan):
                 "counts": counts, "keys": plan["keys"], "runs": rows}
     write_atomic(os.path.join(out, "results.json"), json.dumps(document, indent=1) + "\n")
 
-    metric_keys = sorted({k for row in rows if row["metrics"] for k in row["metrics"]}
-                         - set(plan["keys"]))
+    table = [table_metrics(row["metrics"] or {}) for row in rows]
+    metric_keys = sorted({k for metrics in table for k in metrics} - set(plan["keys"]))
     header = ["run", "status", "reason", *plan["keys"], "run_host", "run_seconds",
               "run_resumed", *metric_keys]
     lines = []
-    for row in rows:
+    for row, metrics in zip(rows, table):
         sweep = row["sweep"] or {}
-        metrics = row["metrics"] or {}
         lines.append([row["run"], row["status"], row["reason"],
                       *[cell(row["values"].get(k)) for k in plan["keys"]],
                       cell(sweep.get("host")), cell(sweep.get("seconds")),
@@ -196,10 +208,11 @@ def draw_chart(plan, rows, chart, path):
 
 def write_charts(plan, rows):
     """The spec's charts (its "charts" list: x or x_metric, y, series, facet, where, log_x, log_y,
-    title, file) as
-    PNG files in OUT: the mean of y over the runs that differ in other keys (seeds, say), with
-    its standard error. Returns their paths."""
+    title, file; a metric is a column of results.csv) as PNG files in OUT: the mean of y over
+    the runs that differ in other keys (seeds, say), with its standard error. Returns their
+    paths."""
     paths = []
+    rows = [{**r, "metrics": table_metrics(r["metrics"] or {})} for r in rows]
     for i, chart in enumerate(plan.get("charts", [])):
         path = os.path.join(plan["out"], chart.get("file", f"chart-{i + 1}.png"))
         try:
