@@ -154,6 +154,27 @@ TEST(SampledFitCli, AnExplicitRcondIsUsedAsGiven) {
   }
 }
 
+// A sweep takes --rcond's values as the command line does.
+TEST(SampledFitCli, ASweepTakesAutoOrACutoff) {
+  const TempDir dir;
+  write_text(dir / "good.json",
+             R"({"task": ["spring"], "fit": ["sampled"], "rcond": ["auto", 1e-3]})");
+  const Result listed =
+      run_hnn({"sweep", (dir / "good.json").string(), "--out", (dir / "good").string(), "--list"},
+              dir.path());
+  ASSERT_EQ(listed.code, 0) << listed.err;
+  EXPECT_NE(listed.out.find("--rcond auto "), std::string::npos) << listed.out;
+  EXPECT_NE(listed.out.find("--rcond 0.001 "), std::string::npos) << listed.out;
+  write_text(dir / "bad.json", R"({"task": ["spring"], "fit": ["sampled"], "rcond": ["often"]})");
+  const Result refused =
+      run_hnn({"sweep", (dir / "bad.json").string(), "--out", (dir / "bad").string(), "--list"},
+              dir.path());
+  EXPECT_EQ(refused.code, 1);
+  EXPECT_NE(refused.err.find(R"(key 'rcond': expected "auto" or a number in (0, 1), got "often")"),
+            std::string::npos)
+      << refused.err;
+}
+
 TEST(SampledFitCli, HelpShowsTheFitOptions) {
   const TempDir dir;
   const Result r = run_hnn({"train", "--help"}, dir.path());
