@@ -132,6 +132,7 @@ void validate_fold(const SystemOn& system_on, const PointSplit& split,
 
 double choose_rcond(const SystemOn& system_on, const std::vector<PointSplit>& folds,
                     std::vector<RcondTrial>& curve) {
+  const BlasThreads threads;
   const std::vector<double> ladder = rcond_ladder();
   std::vector<double> squared(ladder.size(), 0.0);
   std::vector<int> ranks(ladder.size(), 0);
