@@ -106,7 +106,8 @@ const TrainOption kOptions[] = {
      .default_by_task = true},
     {.name = "hidden",
      .kind = ValueKind::kHidden,
-     .help = "Hidden widths, e.g. --hidden 200 200 (overrides --preset)",
+     .help = "Hidden widths, e.g. --hidden 200 200 (overrides --preset; --fit sampled with the "
+             "paper preset takes one layer of 400)",
      .sweep_rank = 5,
      .lands = Lands::kHidden,
      .key = "hidden",
