@@ -252,6 +252,23 @@ TEST(SampledFit, AutoRcondRefitsOnEveryPointAtTheChosenCutoff) {
   }
 }
 
+// auto holds out points: one point leaves none to hold out.
+TEST(SampledFit, AutoRcondNeedsTwoPoints) {
+  const Problem one = pendulum(1, 2);
+  std::mt19937_64 init(1);
+  auto model = make_model<double>(model_config(ModelKind::kHnn, {1}), init);
+  try {
+    fit_sampled(*model, one.x, one.dxdt, {.sampler = HiddenSampler::kElm});
+    ADD_FAILURE() << "one point was validated";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("needs at least 2, got 1; give --rcond"),
+              std::string::npos)
+        << e.what();
+  }
+  EXPECT_NO_THROW(
+      fit_sampled(*model, one.x, one.dxdt, {.sampler = HiddenSampler::kElm, .rcond = 1e-13}));
+}
+
 // A regularisation above the retries' cap (1e-6) is used as given.
 TEST(SampledFit, RegularizationAboveTheCapIsUsed) {
   const Problem train = pendulum(300, 2);
