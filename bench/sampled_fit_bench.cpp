@@ -121,7 +121,7 @@ int main(int argc, char** argv) try {
       nn::parse_name(nn::kLeastSquaresSolverNames, arg(argc, argv, "solver", "qr"), "solver");
   fit.regularization =
       std::stod(arg(argc, argv, "regularization", fmt::format("{}", fit.regularization)));
-  fit.rcond = std::stod(arg(argc, argv, "rcond", fmt::format("{}", fit.rcond)));
+  if (const std::string r = arg(argc, argv, "rcond", "auto"); r != "auto") fit.rcond = std::stod(r);
   fit.tolerance = std::stod(arg(argc, argv, "tolerance", fmt::format("{}", fit.tolerance)));
   fit.max_iterations =
       std::stoi(arg(argc, argv, "max-iterations", fmt::format("{}", fit.max_iterations)));

@@ -42,6 +42,8 @@ void check_train_config(const TrainConfig& c, const FitConfig& fit) {
 TrainConfig train_config(const Task& task, const RunOptions& o, const FitConfig& fit) {
   TrainConfig c = task.train_config();
   if (o.preset == Preset::kLean) c.hidden = task.lean_hidden();
+  // One sampled layer, measured better than two of the paper's widths (docs/sampled.md).
+  if (!fit.steps() && o.preset == Preset::kPaper) c.hidden = {kSampledWidth};
   if (!fit.steps()) c.steps = 0;  // a sampled fit takes none: its runs record so
   if (o.steps) c.steps = *o.steps;
   if (o.batch_size) c.batch_size = *o.batch_size;

@@ -106,7 +106,8 @@ const TrainOption kOptions[] = {
      .default_by_task = true},
     {.name = "hidden",
      .kind = ValueKind::kHidden,
-     .help = "Hidden widths, e.g. --hidden 200 200 (overrides --preset)",
+     .help = "Hidden widths, e.g. --hidden 200 200 (overrides --preset; --fit sampled with the "
+             "paper preset takes one layer of 400)",
      .sweep_rank = 5,
      .lands = Lands::kHidden,
      .key = "hidden",
@@ -311,9 +312,11 @@ const TrainOption kOptions[] = {
      .choices = sampler_names,
      .noun = "sampler"},
     {.name = "rcond",
-     .kind = ValueKind::kFraction,
-     .help = "The least-squares cutoff: singular values below rcond times the largest do not "
-             "shape the last layer, in (0, 1) (default 1e-13)",
+     .kind = ValueKind::kAutoOrFraction,
+     .help = "qr's least-squares cutoff: singular values below rcond times the largest do not "
+             "shape the last layer, a number in (0, 1) (the peer's 1e-13 suits exact dx/dt), or "
+             "auto: the cutoff of 1e-14 ... 1e-1 with the smallest field error on a held-out "
+             "tenth of the points, then refitted on all (default auto)",
      .group = kFitGroup,
      .sweep_rank = 28,
      .applies_to = AppliesTo::kFieldTasks,

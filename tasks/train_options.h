@@ -21,20 +21,21 @@ namespace hnn::tasks {
 
 /// What an option's value is; the checks each front end makes of it.
 enum class ValueKind {
-  kTask,          ///< a task's name (the registry's, tasks/experiments/registry.h)
-  kChoice,        ///< one of TrainOption::choices()
-  kSeed,          ///< an integer from 0 to 2^64 - 1
-  kInt,           ///< an integer from TrainOption::min to max
-  kHidden,        ///< hidden widths, each 1..kMaxWidth
-  kPositiveReal,  ///< a finite number > 0
-  kFraction,      ///< a number in (0, 1)
-  kFile,          ///< a file's name
-  kFolder,        ///< a folder's name (made when missing)
-  kRunFolder,     ///< an existing run folder
-  kJsonObject,    ///< a JSON object (on the command line, its text)
-  kColumns,       ///< a data file's columns (on the command line, comma-separated)
-  kText,          ///< a non-empty string
-  kFlag,          ///< given or not
+  kTask,            ///< a task's name (the registry's, tasks/experiments/registry.h)
+  kChoice,          ///< one of TrainOption::choices()
+  kSeed,            ///< an integer from 0 to 2^64 - 1
+  kInt,             ///< an integer from TrainOption::min to max
+  kHidden,          ///< hidden widths, each 1..kMaxWidth
+  kPositiveReal,    ///< a finite number > 0
+  kFraction,        ///< a number in (0, 1)
+  kAutoOrFraction,  ///< "auto" or a number in (0, 1)
+  kFile,            ///< a file's name
+  kFolder,          ///< a folder's name (made when missing)
+  kRunFolder,       ///< an existing run folder
+  kJsonObject,      ///< a JSON object (on the command line, its text)
+  kColumns,         ///< a data file's columns (on the command line, comma-separated)
+  kText,            ///< a non-empty string
+  kFlag,            ///< given or not
 };
 
 /// The tasks an option applies to. kFieldTasks is checked by each task (Task::check_task_settings

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -60,7 +61,9 @@ Preconditioner cholesky_preconditioner(const ColMat& gram, double regularization
   check_columns(gram.diagonal());
   Preconditioner m{ColMat(p, p), {}};
   m.s = gram.diagonal().cwiseMax(std::numeric_limits<double>::min()).cwiseSqrt().cwiseInverse();
-  for (used = regularization; used <= kLargestRegularization; used *= 10) {
+  // A lambda the user asks above the cap is tried as given (the cap bounds the retries only).
+  const double largest = std::max(kLargestRegularization, regularization);
+  for (used = regularization; used <= largest; used *= 10) {
     m.r = m.s.asDiagonal() * gram * m.s.asDiagonal();
     m.r.diagonal().array() += used;
     if (cholesky_upper(m.r)) {
@@ -72,7 +75,7 @@ Preconditioner cholesky_preconditioner(const ColMat& gram, double regularization
   throw std::invalid_argument(
       fmt::format("sampled fit: the last layer's normal matrix is singular (Cholesky failed up to "
                   "regularisation {:g}); lower the width or give more distinct points",
-                  kLargestRegularization));
+                  largest));
 }
 
 // LSQR (Paige & Saunders 1982) on A M (M the preconditioner), started from c: it solves for the
@@ -173,7 +176,7 @@ LeastSquaresResult solve_least_squares(const LinearSystem& system, const Sampled
   LeastSquaresResult out;
   const Index p = system.unknowns();
   if (config.solver == LeastSquaresSolver::kQr) {
-    solve_by_svd(system, config.rcond, out);
+    solve_by_svd(system, config.rcond.value(), out);
   } else {
     auto start = Clock::now();
     ColMat g(p, p);

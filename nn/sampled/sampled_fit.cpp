@@ -10,6 +10,7 @@
 
 #include "nn/sampled/features.h"
 #include "nn/sampled/least_squares.h"
+#include "nn/sampled/rcond_choice.h"
 #include "nn/sampled/samplers.h"
 
 namespace hnn::nn {
@@ -82,16 +83,17 @@ std::vector<HiddenLayer> sample_hidden(const DynamicsConfig& mc, const ColMat& x
 // The last layer's system: the baseline's outputs, an HNN's field rows (Hadamard form for one
 // hidden layer on unembedded inputs, else formed through every layer).
 std::unique_ptr<sampled::LinearSystem> last_layer_system(const DynamicsConfig& mc,
-                                                         const Fitted& fit, const ColMat& x,
+                                                         const std::vector<HiddenLayer>& layers,
+                                                         const ColMat& last_hidden, const ColMat& x,
                                                          const ColMat& dxdt) {
   if (mc.model == ModelKind::kBaseline) {
-    return std::make_unique<sampled::DenseSystem>(fit.last_hidden, dxdt);
+    return std::make_unique<sampled::DenseSystem>(last_hidden, dxdt);
   }
-  if (fit.layers.size() > 1 || mc.angles > 0) {
-    return std::make_unique<sampled::DenseSystem>(sampled::field_matrix(mc, fit.layers, x),
+  if (layers.size() > 1 || mc.angles > 0) {
+    return std::make_unique<sampled::DenseSystem>(sampled::field_matrix(mc, layers, x),
                                                   ColMat(dxdt.reshaped()));
   }
-  const HiddenLayer& layer = fit.layers.front();
+  const HiddenLayer& layer = layers.front();
   const Index w = layer.w.cols();
   ColMat z = sampled::pre_activation(layer, sampled::mlp_input(mc, x)), slope;
   sampled::activate(mc.activation, z, z, &slope);  // elementwise: the values overwrite z
@@ -115,8 +117,21 @@ Fitted fit_once(const DynamicsConfig& mc, const ColMat& x, const ColMat& dxdt,
   auto start = Clock::now();
   fit.layers = sample_hidden(mc, x, sampler, target, rng, keep_last ? &fit.last_hidden : nullptr);
   report.sample_seconds += seconds_from(start);
+  SampledFitConfig solve = config;
+  if (config.solver == LeastSquaresSolver::kQr && !config.rcond) {
+    start = Clock::now();
+    const auto on = [&](const std::vector<Index>& rows) {
+      const ColMat hidden =
+          mc.model == ModelKind::kBaseline ? ColMat(fit.last_hidden(rows, Eigen::all)) : ColMat();
+      return last_layer_system(mc, fit.layers, hidden, x(rows, Eigen::all), dxdt(rows, Eigen::all));
+    };
+    solve.rcond =
+        sampled::choose_rcond(on, sampled::validation_folds(x.rows()), report.rcond_validation);
+    report.validation_seconds += seconds_from(start);
+  }
+  report.rcond = solve.rcond.value_or(0);
   start = Clock::now();
-  const auto system = last_layer_system(mc, fit, x, dxdt);
+  const auto system = last_layer_system(mc, fit.layers, fit.last_hidden, x, dxdt);
   report.assemble_seconds += seconds_from(start);
   report.rows = std::size_t(system->equations() * system->rhs_columns());
   report.columns = std::size_t(system->unknowns() * system->rhs_columns());
@@ -126,7 +141,7 @@ Fitted fit_once(const DynamicsConfig& mc, const ColMat& x, const ColMat& dxdt,
         "lower the width or give more points",
         system->unknowns(), system->equations(), x.rows()));
   }
-  const sampled::LeastSquaresResult solved = sampled::solve_least_squares(*system, config);
+  const sampled::LeastSquaresResult solved = sampled::solve_least_squares(*system, solve);
   report.assemble_seconds += solved.gram_seconds;
   report.gram_seconds += solved.gram_seconds;
   report.solve_seconds += solved.solve_seconds;

@@ -8,7 +8,9 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "nn/dynamics.h"
 #include "nn/enum_names.h"
@@ -44,20 +46,30 @@ inline constexpr NameTable<LeastSquaresSolver, 3> kLeastSquaresSolverNames{{
 /// Settings of a sampled fit. The defaults reproduce the peer's accuracy (docs/sampled.md).
 struct SampledFitConfig {
   HiddenSampler sampler = HiddenSampler::kUswim;
-  /// Singular values below rcond times the largest do not shape the solution (the peer's
-  /// np.linalg.lstsq rcond); each solver honours it in its own way (docs/sampled.md).
-  double rcond = 1e-13;
+  /// kQr: singular values below rcond times the largest do not shape the solution (the peer's
+  /// np.linalg.lstsq rcond). Empty (auto, the default): chosen by validation on held-out tenths
+  /// of the points, then the fit runs again on all of them at that cutoff (rcond_choice.h).
+  std::optional<double> rcond{};
   std::uint64_t seed = 0;
   /// kQr by default: the only solver that keeps the peer's accuracy (docs/sampled.md).
   LeastSquaresSolver solver = LeastSquaresSolver::kQr;
   /// lambda, added to the diagonal of A^T A after its columns are scaled to unit norm, for
   /// kCholesky and kLsqr's preconditioner. When the Cholesky factorisation fails, lambda is
-  /// raised tenfold until it succeeds (at most to 1e-6; beyond, the system is called singular).
+  /// raised tenfold until it succeeds (at most to 1e-6, or to lambda itself when larger; beyond,
+  /// the system is called singular).
   double regularization = 1e-13;
   /// kLsqr stops when the normal-equation residual |A^T r| falls below tolerance * |A| |r|.
   double tolerance = 1e-14;
   /// kLsqr's iteration cap.
   int max_iterations = 200;
+};
+
+/// One cutoff of --rcond auto's ladder: the relative field error on the held-out points of the
+/// fit on the others, and how many singular values it kept.
+struct RcondTrial {
+  double rcond = 0;
+  double error = 0;
+  int rank = 0;
 };
 
 /// What a fit did, for metrics.json and the closing figures.
@@ -73,6 +85,9 @@ struct SampledFitReport {
   std::size_t matrix_bytes = 0;  // the largest matrices held at once
   double residual_rms = 0;       // root mean square of the system's residual on the fit data
   int iterations = 0;            // of an iterative solver; 0 for a direct one
+  double rcond = 0;              // kQr: the cutoff the solve used (auto: the one chosen)
+  std::vector<RcondTrial> rcond_validation;  // auto: every cutoff tried (the last fit's)
+  double validation_seconds = 0;             // auto: choosing the cutoff (not in the others)
 };
 
 /// Samples every hidden layer of `model` and solves its last layer so that model.field(x)

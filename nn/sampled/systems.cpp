@@ -91,6 +91,10 @@ ColMat HadamardSystem::formed() const {
 
 void HadamardSystem::reduced(ColMat& a, ColMat& b) const {
   const Index n = d_.rows(), w = d_.cols(), dim = v_.rows();
+  if (n < w) {  // fewer points than neurons: D has no square R, and A is no taller than R's form
+    LinearSystem::reduced(a, b);
+    return;
+  }
   ColMat q = d_;
   ColMat qtb = b_.reshaped(n, dim);
   const ColMat r = qr_apply(q, qtb);

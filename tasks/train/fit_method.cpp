@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include "tasks/error.h"
 #include "tasks/report/json_values.h"
@@ -15,6 +16,18 @@ namespace {
 void check_fraction(double value, const std::string& key, const std::string& task) {
   HNN_TASKS_CHECK(value > 0 && value < 1, "{}: --{} must be in (0, 1), got {}", task,
                   fit_option_name(key), value);
+}
+
+// "rcond": "auto" (chosen by validation, nn/sampled/rcond_choice.h; also when absent) or a
+// number in (0, 1).
+std::optional<double> rcond_setting(const json& s, const std::string& task) {
+  const auto it = s.find("rcond");
+  if (it == s.end() || *it == "auto") return std::nullopt;
+  HNN_TASKS_CHECK(it->is_number(), "{}: --rcond must be auto or a number in (0, 1), got {}", task,
+                  it->dump());
+  const double rcond = it->get<double>();
+  check_fraction(rcond, "rcond", task);
+  return rcond;
 }
 
 }  // namespace
@@ -53,20 +66,19 @@ FitConfig fit_config(const json& s, const std::string& task) {
           nn::parse_name(nn::kLeastSquaresSolverNames, s["solver"].get<std::string>(), "solver");
     }
     nn::SampledFitConfig& f = c.sampled;
-    f.rcond = s.value("rcond", f.rcond);
     f.regularization = s.value("regularization", f.regularization);
     f.tolerance = s.value("solver_tolerance", f.tolerance);
     f.max_iterations = s.value("solver_iterations", f.max_iterations);
   } catch (const std::exception& e) {
     throw Error(fmt::format("{}: bad fit settings {}: {}", task, s.dump(), e.what()));
   }
+  c.sampled.rcond = rcond_setting(s, task);
   for (const std::string& key : fit_setting_names()) {
     HNN_TASKS_CHECK(c.samples() || key == "fit" || !s.contains(key),
                     "{}: --{} applies to a sampled fit only (add --fit sampled or --fit "
                     "sampled+adam)",
                     task, fit_option_name(key));
   }
-  check_fraction(c.sampled.rcond, "rcond", task);
   check_fraction(c.sampled.tolerance, "solver_tolerance", task);
   HNN_TASKS_CHECK(c.sampled.regularization > 0 && std::isfinite(c.sampled.regularization),
                   "{}: --regularization must be a finite number > 0, got {}", task,
@@ -77,10 +89,25 @@ FitConfig fit_config(const json& s, const std::string& task) {
   return c;
 }
 
+namespace {
+
+// --rcond auto's ladder: [{"rcond": 1e-14, "error": 0.05, "rank": 100}, ...]; empty otherwise.
+json rcond_curve(const std::vector<nn::RcondTrial>& curve) {
+  json out = json::array();
+  for (const nn::RcondTrial& t : curve)
+    out.push_back({{"rcond", t.rcond}, {"error", number(t.error)}, {"rank", t.rank}});
+  return out;
+}
+
+}  // namespace
+
 json fit_report_json(const FitConfig& config, const nn::SampledFitReport& r) {
   return {{"method", config.name()},
           {"sampler", nn::name_of(nn::kHiddenSamplerNames, config.sampled.sampler)},
-          {"rcond", config.sampled.rcond},
+          {"rcond", config.sampled.rcond ? json(*config.sampled.rcond) : json("auto")},
+          {"rcond_used", r.rcond > 0 ? json(r.rcond) : json()},  // null: a solver without it
+          {"rcond_validation", rcond_curve(r.rcond_validation)},
+          {"validation_seconds", r.validation_seconds},
           {"solver", r.solver},
           {"regularization", config.sampled.regularization},
           {"regularization_used", r.regularization},

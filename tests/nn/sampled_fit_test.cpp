@@ -85,7 +85,7 @@ TEST(SampledFit, HnnMatchesThePendulumFieldAndEnergy) {
   std::vector<double> errors;
   for (LeastSquaresSolver solver :
        {LeastSquaresSolver::kQr, LeastSquaresSolver::kLsqr, LeastSquaresSolver::kCholesky}) {
-    auto model = pendulum_hnn({.solver = solver});
+    auto model = pendulum_hnn({.rcond = 1e-13, .solver = solver});  // the peer's cutoff
     errors.push_back(field_error(*model, test));
     EXPECT_LT(errors.back(), 3e-2) << name_of(kLeastSquaresSolverNames, solver);
     EXPECT_LT(energy_error(dynamic_cast<Hnn<double>&>(*model), test), 3e-3);
@@ -198,6 +198,86 @@ TEST(SampledFit, SingularSystemIsRefused) {
     }
   }
   EXPECT_EQ(model->mlp().layers()[1].weight().value(), before);  // nothing written
+}
+
+// --rcond auto (nn/sampled/rcond_choice.h): on exact derivatives the held-out error keeps
+// falling to the smallest cutoffs; on noisy ones a fit that keeps the small singular values
+// interpolates the noise, and a large cutoff wins.
+TEST(SampledFit, AutoRcondIsLargeOnNoisyDataAndSmallOnExactData) {
+  const Problem exact = pendulum(300, 2);
+  Problem noisy = exact;
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> noise(0, 0.1);
+  for (Index i = 0; i < noisy.dxdt.size(); ++i) noisy.dxdt.data()[i] += noise(rng);
+  const auto chosen = [](const Problem& data) {
+    std::mt19937_64 init(1);
+    auto model = make_model<double>(model_config(ModelKind::kHnn, {100}), init);
+    return fit_sampled(*model, data.x, data.dxdt, {});
+  };
+  const SampledFitReport on_exact = chosen(exact), on_noisy = chosen(noisy);
+  EXPECT_LE(on_exact.rcond, 1e-9);
+  EXPECT_GE(on_noisy.rcond, 1e-5);
+  ASSERT_EQ(on_noisy.rcond_validation.size(), 14u);  // 1e-14 ... 1e-1
+  EXPECT_DOUBLE_EQ(on_noisy.rcond_validation.front().rcond, 1e-14);
+  for (std::size_t i = 1; i < on_noisy.rcond_validation.size(); ++i) {
+    const RcondTrial &smaller = on_noisy.rcond_validation[i - 1], &t = on_noisy.rcond_validation[i];
+    EXPECT_LE(t.rank, smaller.rank);
+    if (t.rcond == on_noisy.rcond) {  // the smallest held-out error
+      for (const RcondTrial& other : on_noisy.rcond_validation) EXPECT_GE(other.error, t.error);
+    }
+  }
+  EXPECT_GT(on_noisy.validation_seconds, 0);
+}
+
+// After the choice the fit runs again on every point at the chosen cutoff: the same weights as
+// an explicit --rcond of that value (the hidden layers' draws do not see the split); the
+// baseline (several outputs, a formed matrix) alike.
+TEST(SampledFit, AutoRcondRefitsOnEveryPointAtTheChosenCutoff) {
+  Problem data = pendulum(300, 2);
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> noise(0, 0.05);
+  for (Index i = 0; i < data.dxdt.size(); ++i) data.dxdt.data()[i] += noise(rng);
+  for (ModelKind kind : {ModelKind::kHnn, ModelKind::kBaseline}) {
+    std::mt19937_64 init(1);
+    auto automatic = make_model<double>(model_config(kind, {60}), init);
+    auto explicit_model = make_model<double>(model_config(kind, {60}), init);
+    const SampledFitReport report = fit_sampled(*automatic, data.x, data.dxdt, {});
+    EXPECT_EQ(report.rcond_validation.size(), 14u);
+    fit_sampled(*explicit_model, data.x, data.dxdt, {.rcond = report.rcond});
+    for (Index layer : {0, 1}) {
+      EXPECT_EQ(automatic->mlp().layers()[layer].weight().value(),
+                explicit_model->mlp().layers()[layer].weight().value())
+          << to_string(kind) << " layer " << layer;
+    }
+  }
+}
+
+// auto holds out points: one point leaves none to hold out.
+TEST(SampledFit, AutoRcondNeedsTwoPoints) {
+  const Problem one = pendulum(1, 2);
+  std::mt19937_64 init(1);
+  auto model = make_model<double>(model_config(ModelKind::kHnn, {1}), init);
+  try {
+    fit_sampled(*model, one.x, one.dxdt, {.sampler = HiddenSampler::kElm});
+    ADD_FAILURE() << "one point was validated";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("needs at least 2, got 1; give --rcond"),
+              std::string::npos)
+        << e.what();
+  }
+  EXPECT_NO_THROW(
+      fit_sampled(*model, one.x, one.dxdt, {.sampler = HiddenSampler::kElm, .rcond = 1e-13}));
+}
+
+// A regularisation above the retries' cap (1e-6) is used as given.
+TEST(SampledFit, RegularizationAboveTheCapIsUsed) {
+  const Problem train = pendulum(300, 2);
+  std::mt19937_64 init(1);
+  auto model = make_model<double>(model_config(ModelKind::kHnn, {60}), init);
+  const SampledFitReport report =
+      fit_sampled(*model, train.x, train.dxdt,
+                  {.solver = LeastSquaresSolver::kCholesky, .regularization = 1e-3});
+  EXPECT_EQ(report.regularization, 1e-3);
 }
 
 // The fit allocates its matrices once: LSQR's iterations allocate nothing, so a fit of 25

@@ -42,6 +42,17 @@ TEST(SampledSystems, HadamardGramEqualsTheFormedNormalMatrix) {
   }
 }
 
+// Fewer points than neurons: D has no square R, and the reduction is A itself (it was a LAPACK
+// error before: `hnn train spring --fit sampled --hidden 1000` on 750 points).
+TEST(SampledSystems, FewerPointsThanNeuronsReduceToTheFormedMatrix) {
+  const Eigen::Index n = 5, w = 8, dim = 2;
+  const HadamardSystem system(ColMat::Random(n, w), ColMat::Random(dim, w), ColMat::Random(n, dim));
+  ColMat ra, rb;
+  system.reduced(ra, rb);
+  EXPECT_EQ(ra, system.formed());
+  EXPECT_EQ(rb, system.rhs());
+}
+
 // The formed path (tangents through the layers) gives the Hadamard form's matrix for one layer,
 // and matches central differences of the hidden outputs through the angle embedding.
 TEST(SampledSystems, FormedFieldMatrixMatchesHadamardAndDifferences) {

@@ -29,11 +29,10 @@ Result train_spring(const TempDir& dir, const std::string& name, std::vector<std
 
 TEST(SampledFitCli, ASampledSpringHnnIsAnOrdinaryRunFolderThatKeepsTheEnergyAdvantage) {
   const TempDir dir;
-  // The spring's dx/dt are noisy: with singular values below 1e-3 of the largest cut off, the
-  // learned H keeps closed level sets beyond the data (at the default 1e-13 its rollouts run
-  // away, the baseline's further still).
-  const std::vector<std::string> fit = {"--fit",   "sampled", "--solver", "qr",
-                                        "--rcond", "1e-3",    "--quiet"};
+  // The spring's dx/dt are noisy: --rcond auto (the default) cuts off the singular values that
+  // only fit the noise, and the learned H keeps closed level sets beyond the data (at the peer's
+  // 1e-13 its rollouts run away, the baseline's further still).
+  const std::vector<std::string> fit = {"--fit", "sampled", "--quiet"};
   const Result hnn = train_spring(dir, "hnn", fit);
   ASSERT_EQ(hnn.code, 0) << hnn.err;
   std::vector<std::string> as_baseline = fit;
@@ -51,6 +50,12 @@ TEST(SampledFitCli, ASampledSpringHnnIsAnOrdinaryRunFolderThatKeepsTheEnergyAdva
   EXPECT_EQ(report.at("columns").get<int>(), 100);
   EXPECT_EQ(report.at("rows").get<int>(), 750 * 2);  // dH/dp and -dH/dq of each training state
   EXPECT_GT(report.at("matrix_bytes").get<double>(), 0);
+  // The cutoff chosen on a held-out tenth, and the error of each cutoff tried.
+  EXPECT_EQ(report.at("rcond"), "auto");
+  EXPECT_GE(report.at("rcond_used").get<double>(), 1e-6);
+  EXPECT_EQ(report.at("rcond_validation").size(), 14u);
+  EXPECT_EQ(report.at("rcond_validation").front().at("rcond").get<double>(), 1e-14);
+  EXPECT_GT(report.at("rcond_validation").front().at("error").get<double>(), 0);
   EXPECT_EQ(m.at("steps"), 0);
   EXPECT_EQ(m.at("task_settings").at("fit"), "sampled");
   EXPECT_GE(m.at("train_seconds").get<double>(),
@@ -67,6 +72,7 @@ TEST(SampledFitCli, ASampledSpringHnnIsAnOrdinaryRunFolderThatKeepsTheEnergyAdva
   EXPECT_NE(shown.out.find("spring hnn: seed 0, sampled fit (elm), hidden 100"), std::string::npos)
       << shown.out;
   EXPECT_NE(shown.out.find("  fit        sampling "), std::string::npos) << shown.out;
+  EXPECT_NE(shown.out.find("  rcond      auto chose "), std::string::npos) << shown.out;
   // Evaluated again, rolled out and exported like any run.
   const Result evaluated = run_hnn({"evaluate", (dir / "hnn").string()}, dir.path());
   ASSERT_EQ(evaluated.code, 0) << evaluated.err;
@@ -102,6 +108,7 @@ TEST(SampledFitCli, SampledThenAdamRunsItsStepsFromTheSampledWeights) {
   ASSERT_EQ(r.code, 0) << r.err;
   const json m = read_json(dir / "run" / "metrics.json");
   EXPECT_EQ(m.at("fit").at("method"), "sampled+adam");
+  EXPECT_EQ(m.at("fit").at("rcond"), "auto");
   EXPECT_EQ(m.at("steps"), 20);
   const std::vector<std::string> curve = lines(read_text(dir / "run" / "loss_curve.csv"));
   ASSERT_FALSE(curve.empty());
@@ -196,6 +203,42 @@ TEST(SampledFitCli, TheDataTaskFitsItsTrainingSplit) {
   EXPECT_LT(m.at("test_loss").get<double>(), 1e-2);
 }
 
+// An explicit --rcond is used as given, with no validation; "auto" given is the default.
+TEST(SampledFitCli, AnExplicitRcondIsUsedAsGiven) {
+  const TempDir dir;
+  for (const char* rcond : {"1e-3", "auto"}) {
+    const Result r = train_spring(dir, rcond, {"--fit", "sampled", "--rcond", rcond});
+    ASSERT_EQ(r.code, 0) << r.err;
+    const json fit = read_json(dir / rcond / "metrics.json").at("fit");
+    const bool given = std::string(rcond) != "auto";
+    EXPECT_EQ(fit.at("rcond"), given ? json(1e-3) : json("auto"));
+    EXPECT_EQ(fit.at("rcond_validation").empty(), given);
+    if (given) EXPECT_EQ(fit.at("rcond_used").get<double>(), 1e-3);
+    EXPECT_NE(r.out.find(given ? "(qr, rcond 0.001)" : "auto chose"), std::string::npos) << r.out;
+  }
+}
+
+// A sweep takes --rcond's values as the command line does.
+TEST(SampledFitCli, ASweepTakesAutoOrACutoff) {
+  const TempDir dir;
+  write_text(dir / "good.json",
+             R"({"task": ["spring"], "fit": ["sampled"], "rcond": ["auto", 1e-3]})");
+  const Result listed =
+      run_hnn({"sweep", (dir / "good.json").string(), "--out", (dir / "good").string(), "--list"},
+              dir.path());
+  ASSERT_EQ(listed.code, 0) << listed.err;
+  EXPECT_NE(listed.out.find("--rcond auto "), std::string::npos) << listed.out;
+  EXPECT_NE(listed.out.find("--rcond 0.001 "), std::string::npos) << listed.out;
+  write_text(dir / "bad.json", R"({"task": ["spring"], "fit": ["sampled"], "rcond": ["often"]})");
+  const Result refused =
+      run_hnn({"sweep", (dir / "bad.json").string(), "--out", (dir / "bad").string(), "--list"},
+              dir.path());
+  EXPECT_EQ(refused.code, 1);
+  EXPECT_NE(refused.err.find(R"(key 'rcond': expected "auto" or a number in (0, 1), got "often")"),
+            std::string::npos)
+      << refused.err;
+}
+
 TEST(SampledFitCli, HelpShowsTheFitOptions) {
   const TempDir dir;
   const Result r = run_hnn({"train", "--help"}, dir.path());
@@ -209,7 +252,7 @@ TEST(SampledFitCli, HelpShowsTheFitOptions) {
   for (const auto& [option, value] : std::vector<std::pair<std::string, std::string>>{
            {"--sampler", std::string(nn::name_of(nn::kHiddenSamplerNames, defaults.sampler))},
            {"--solver", std::string(nn::name_of(nn::kLeastSquaresSolverNames, defaults.solver))},
-           {"--rcond", fmt::format("{:g}", defaults.rcond)},
+           {"--rcond", defaults.rcond ? fmt::format("{:g}", *defaults.rcond) : "auto"},
            {"--regularization", fmt::format("{:g}", defaults.regularization)},
            {"--solver-tolerance", fmt::format("{:g}", defaults.tolerance)},
            {"--solver-iterations", fmt::format("{}", defaults.max_iterations)}}) {

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <optional>
 
 #include "tasks/experiments/registry.h"
 #include "tasks/field/field_task.h"
@@ -45,6 +46,23 @@ TEST(Presets, PaperIsTheTasksOwnConfiguration) {
     EXPECT_EQ(paper.steps, own.steps) << name;
     EXPECT_EQ(paper.batch_size, own.batch_size) << name;
   }
+}
+
+// A sampled fit's paper preset is one layer of kSampledWidth (two sampled layers of 200 let the
+// spring's rollouts run away, docs/sampled.md); lean and --hidden stay as they are, and
+// sampled+adam keeps the paper's widths for its Adam steps.
+TEST(Presets, ASampledFitTakesOneWiderLayer) {
+  const auto task = make_task("spring");
+  const auto hidden = [&](const char* fit, Preset preset, std::optional<std::vector<int>> given) {
+    RunOptions o{.task = "spring", .preset = preset, .hidden = given};
+    o.task_settings["fit"] = fit;
+    return resolve(*task, o).train.hidden;
+  };
+  EXPECT_EQ(hidden("sampled", Preset::kPaper, {}), (std::vector<int>{kSampledWidth}));
+  EXPECT_EQ(hidden("sampled", Preset::kLean, {}), task->lean_hidden());
+  EXPECT_EQ(hidden("sampled", Preset::kPaper, std::vector<int>{50, 50}),
+            (std::vector<int>{50, 50}));
+  EXPECT_EQ(hidden("sampled+adam", Preset::kPaper, {}), (std::vector<int>{200, 200}));
 }
 
 // Lean changes the widths only, and to a smaller model on every swept task but three-body

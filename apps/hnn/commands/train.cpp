@@ -143,6 +143,8 @@ std::string metavar(const tasks::TrainOption& option) {
     case ValueKind::kPositiveReal:
     case ValueKind::kFraction:
       return "X";
+    case ValueKind::kAutoOrFraction:
+      return "auto|X";
     case ValueKind::kFile:
       return "FILE";
     case ValueKind::kFolder:
@@ -185,6 +187,8 @@ CLI::Option* add_option(CLI::App& cmd, const tasks::TrainOption& option, Given& 
     case ValueKind::kFraction:
       return cmd.add_option(name, given.real, help)
           ->check(CLI::Range(0.0, 1.0).description("in (0, 1)"));
+    case ValueKind::kAutoOrFraction:
+      return cmd.add_option(name, given.text, help)->check(auto_or_fraction());
     case ValueKind::kColumns:
       return cmd.add_option(name, given.texts, help)->delimiter(',');
     case ValueKind::kRunFolder:
@@ -209,6 +213,8 @@ nlohmann::json given_value(const tasks::TrainOption& option, const Given& given)
     case ValueKind::kPositiveReal:
     case ValueKind::kFraction:
       return given.real;
+    case ValueKind::kAutoOrFraction:  // checked by auto_or_fraction()
+      return given.text == "auto" ? nlohmann::json("auto") : nlohmann::json(std::stod(given.text));
     case ValueKind::kColumns:
       return given.texts;
     case ValueKind::kJsonObject:

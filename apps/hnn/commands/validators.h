@@ -62,4 +62,16 @@ inline CLI::Validator positive_real() {
       "POSITIVE");
 }
 
+/// "auto", or a number in (0, 1) (--rcond).
+inline CLI::Validator auto_or_fraction() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        double value = 0;
+        if (text == "auto" || (detail::parse_whole(text, value) && value > 0 && value < 1))
+          return "";
+        return "expected auto or a number in (0, 1), got '" + text + "'";
+      },
+      "AUTO|X");
+}
+
 }  // namespace hnn::app

@@ -123,6 +123,10 @@ ordered_json checked_value(const TrainOption& key, const ordered_json& v) {
     case ValueKind::kFraction:
       if (v.is_number() && v.get<double>() > 0 && v.get<double>() < 1) return v;
       throw std::invalid_argument(fmt::format("expected a number in (0, 1), got {}", v.dump()));
+    case ValueKind::kAutoOrFraction:
+      if (v == "auto" || (v.is_number() && v.get<double>() > 0 && v.get<double>() < 1)) return v;
+      throw std::invalid_argument(
+          fmt::format("expected \"auto\" or a number in (0, 1), got {}", v.dump()));
     case ValueKind::kFile:
       if (v.is_string() && !v.get<std::string>().empty())
         return fs::absolute(v.get<std::string>()).lexically_normal().string();
