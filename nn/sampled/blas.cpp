@@ -20,6 +20,12 @@ void dormqr_(const char* side, const char* trans, const int* m, const int* n, co
 void dgelsd_(const int* m, const int* n, const int* nrhs, double* a, const int* lda, double* b,
              const int* ldb, double* s, const double* rcond, int* rank, double* work,
              const int* lwork, int* iwork, int* info);
+void dtpqrt_(const int* m, const int* n, const int* l, const int* nb, double* a, const int* lda,
+             double* b, const int* ldb, double* t, const int* ldt, double* work, int* info);
+void dtpmqrt_(const char* side, const char* trans, const int* m, const int* n, const int* k,
+              const int* l, const int* nb, const double* v, const int* ldv, const double* t,
+              const int* ldt, double* a, const int* lda, double* b, const int* ldb, double* work,
+              int* info);
 }
 
 namespace hnn::nn::sampled {
@@ -68,6 +74,24 @@ ColMat qr_apply(ColMat& a, ColMat& b) {
         fmt::format("sampled fit: LAPACK dgeqrf/dormqr failed (info {})", info));
   }
   return a.topRows(n).triangularView<Eigen::Upper>();
+}
+
+void qr_merge_triangle(ColMat& r, ColMat& t, ColMat& c, ColMat& d) {
+  const auto n = int(r.cols()), nrhs = int(c.cols());
+  // The block size of dtpqrt's compact WY form: its trailing updates are GEMMs of this depth.
+  const int nb = std::min(n, 128);
+  std::vector<double> tf(std::size_t(nb) * std::size_t(n));
+  std::vector<double> work(std::size_t(nb) * std::size_t(std::max(n, nrhs)));
+  int info = 0;
+  dtpqrt_(&n, &n, &n, &nb, r.data(), &n, t.data(), &n, tf.data(), &nb, work.data(), &info);
+  if (info == 0) {
+    dtpmqrt_("L", "T", &n, &nrhs, &n, &n, &nb, t.data(), &n, tf.data(), &nb, c.data(), &n, d.data(),
+             &n, work.data(), &info);
+  }
+  if (info != 0) {
+    throw std::runtime_error(
+        fmt::format("sampled fit: LAPACK dtpqrt/dtpmqrt failed (info {})", info));
+  }
 }
 
 void solve_upper(const ColMat& r, bool transpose, ColMat& y) {

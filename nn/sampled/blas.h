@@ -29,6 +29,10 @@ void blas_gram(const double* a, Eigen::Index rows, Eigen::Index cols, Eigen::Ind
 bool cholesky_upper(ColMat& g);
 /// a = QR in place (Householder, LAPACK's dgeqrf), then b <- Q^T b; returns R (a.cols() square).
 ColMat qr_apply(ColMat& a, ColMat& b);
+/// [r; t] = Q [r'; 0] for upper-triangular n x n r and t (LAPACK's dtpqrt, 2/3 n^3 FLOP
+/// against dgeqrf's 10/3 n^3 on the formed 2n x n stack): r <- r', and [c; d] <- Q^T [c; d]
+/// (n x m each). t and d are destroyed.
+void qr_merge_triangle(ColMat& r, ColMat& t, ColMat& c, ColMat& d);
 /// y <- R^-1 y, or y <- R^-T y (transpose), for an upper-triangular R.
 void solve_upper(const ColMat& r, bool transpose, ColMat& y);
 /// min |a x - b| by LAPACK's dgelsd (the SVD solver np.linalg.lstsq runs); singular values below

@@ -99,6 +99,10 @@ void HadamardSystem::reduced(ColMat& a, ColMat& b) const {
   ColMat qtb = b_.reshaped(n, dim);
   const ColMat r = qr_apply(q, qtb);
   q = ColMat();
+  if (v_.cols() == w) {
+    merge_blocks(r, qtb, a, b);
+    return;
+  }
   a.resize(dim * w, v_.cols());
   b.resize(dim * w, 1);
   for (Index i = 0; i < dim; ++i) {
@@ -106,6 +110,20 @@ void HadamardSystem::reduced(ColMat& a, ColMat& b) const {
       a.col(col).segment(i * w, w) = r.col(col % w) * v_(i, col);
     }
     b.col(0).segment(i * w, w) = qtb.col(i).head(w);
+  }
+}
+
+// One column block: every row block R diag(v_i) is upper triangular, so the stack's QR is the
+// first block merged with the others one at a time (dtpqrt), and the reduction is w x w.
+void HadamardSystem::merge_blocks(const ColMat& r, const ColMat& qtb, ColMat& a, ColMat& b) const {
+  const Index w = d_.cols(), dim = v_.rows();
+  a = r * v_.row(0).asDiagonal();
+  b = qtb.col(0).head(w);
+  ColMat t(w, w), d(w, 1);
+  for (Index i = 1; i < dim; ++i) {
+    t.noalias() = r * v_.row(i).asDiagonal();
+    d = qtb.col(i).head(w);
+    qr_merge_triangle(a, t, b, d);
   }
 }
 

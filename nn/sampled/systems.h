@@ -68,10 +68,13 @@ class HadamardSystem final : public LinearSystem {
   ColMat formed() const override;
   /// With D = QR (N x width): row block i becomes R diag(v_i), its targets the first width
   /// entries of Q^T b_i, as Q is the same for every block: dim * width rows instead of dim * N.
+  /// With one column block (an HNN) the triangular row blocks are merged: width rows.
   void reduced(ColMat& a, ColMat& b) const override;
   std::size_t bytes() const override;
 
  private:
+  void merge_blocks(const ColMat& r, const ColMat& qtb, ColMat& a, ColMat& b) const;
+
   ColMat d_, v_, b_;          // b_: N * dim x 1, coordinate-major (row i * N + n)
   mutable ColMat y_, q_, p_;  // apply's (y_: dim x width) and apply_t's work, allocated once
 };
