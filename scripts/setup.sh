@@ -10,7 +10,7 @@ packages=(
   libgif-dev libpng-dev libopenblas-pthread-dev libxtensor-dev libzip-dev libginac-dev libyaml-cpp-dev
   libssl-dev
   python3-matplotlib python3-numpy python3-distributed
-  pybind11-dev python3-dev
+  pybind11-dev python3-dev python3-pytest
 )
 
 missing=()

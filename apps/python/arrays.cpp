@@ -4,6 +4,7 @@
 #include <fmt/ranges.h>
 
 #include <cmath>
+#include <cstdint>
 #include <string>
 
 namespace hnn::python {
@@ -40,6 +41,24 @@ void check_finite(const T* data, Eigen::Index rows, Eigen::Index cols, std::stri
   }
 }
 
+// `a` (2-D, of dtype S) copied into `out` as T, reading its strides: one copy whatever the
+// layout (Fortran order, slices). False when `a` is not of S or its strides are not whole,
+// non-negative steps of S (then states() lets NumPy convert it first).
+template <typename S, typename T>
+bool copy_strided(const py::array& a, Matrix<T>& out) {
+  constexpr auto size = py::ssize_t(sizeof(S));
+  if (!py::isinstance<py::array_t<S>>(a)) return false;
+  if (a.strides(0) < 0 || a.strides(1) < 0 || a.strides(0) % size || a.strides(1) % size)
+    return false;
+  using Source = Eigen::Matrix<S, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  using Steps = Eigen::Stride<Eigen::Dynamic, Eigen::Dynamic>;
+  const Eigen::Map<const Source, Eigen::Unaligned, Steps> in(
+      static_cast<const S*>(a.data()), a.shape(0), a.shape(1),
+      Steps(a.strides(0) / size, a.strides(1) / size));
+  out = in.template cast<T>();
+  return true;
+}
+
 }  // namespace
 
 template <typename T>
@@ -54,10 +73,16 @@ Matrix<T> states(const py::handle& obj, std::string_view what, Eigen::Index cols
         fmt::format("{}: expected {} columns (q then p), got shape {}", what, cols, shape_text(a)));
   }
   if (a.shape(0) == 0) throw InputError(fmt::format("{}: the array is empty (no rows)", what));
-  // Converted once to C order and T (a contiguous array of T is used as it is).
-  const auto c = py::array_t<T, py::array::c_style | py::array::forcecast>::ensure(a);
-  check_finite(c.data(), a.shape(0), cols, what);
-  return Eigen::Map<const Matrix<T>>(c.data(), a.shape(0), cols);
+  // Copied once into the row-major matrix the library's functions take (docs/python.md: why
+  // not a view), converted on the way from the common dtypes in any layout.
+  Matrix<T> out;
+  if (!(copy_strided<double>(a, out) || copy_strided<float>(a, out) ||
+        copy_strided<std::int64_t>(a, out) || copy_strided<std::int32_t>(a, out))) {
+    const auto c = py::array_t<T, py::array::c_style | py::array::forcecast>::ensure(a);
+    out = Eigen::Map<const Matrix<T>>(c.data(), a.shape(0), cols);
+  }
+  check_finite(out.data(), out.rows(), cols, what);
+  return out;
 }
 
 std::vector<physics::Batch> trajectories(const py::handle& obj, std::string_view what,

@@ -1,0 +1,13 @@
+# Types of hnn.autodiff (autodiff.py), for editors; tests/python/hnn_test.py checks that it
+# names every name of __all__.
+import numpy as np
+from numpy.typing import ArrayLike
+
+from ._hnn import Model, _systems
+
+__all__: list[str]
+
+def derivative(f: Model | _systems.System, x: ArrayLike, order: int) -> np.ndarray: ...
+def grad(f: Model | _systems.System, x: ArrayLike) -> np.ndarray: ...
+def hessian(f: Model | _systems.System, x: ArrayLike) -> np.ndarray: ...
+def jacobian(model: Model, x: ArrayLike) -> np.ndarray: ...
