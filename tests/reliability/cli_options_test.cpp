@@ -90,7 +90,7 @@ std::vector<BadOption> bad_fit_options() {
       " does not apply to --fit sampled: it takes no training steps (the hidden layers are "
       "sampled, the last layer solved); --fit sampled+adam fine-tunes with Adam from there";
   std::vector<BadOption> bad;
-  for (const std::vector<std::string> option :
+  for (const std::vector<std::string>& option :
        std::vector<std::vector<std::string>>{{"--steps", "10"},
                                              {"--batch", "10"},
                                              {"--lr", "0.1"},
@@ -99,7 +99,7 @@ std::vector<BadOption> bad_fit_options() {
     bad.push_back(
         {{"train", "spring", "--fit", "sampled", option[0], option[1]}, option[0] + no_steps});
   }
-  for (const std::vector<std::string> option :
+  for (const std::vector<std::string>& option :
        std::vector<std::vector<std::string>>{{"--sampler", "elm"},
                                              {"--rcond", "1e-10"},
                                              {"--solver", "qr"},

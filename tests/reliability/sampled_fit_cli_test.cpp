@@ -176,7 +176,7 @@ TEST(SampledFitCli, ASampledThenAdamFitThatFailsWritesNothing) {
 
 TEST(SampledFitCli, ThePixelPendulumSaysWhyItTakesNoFit) {
   const TempDir dir;
-  for (const std::vector<std::string> option :
+  for (const std::vector<std::string>& option :
        {std::vector<std::string>{"--fit", "sampled"}, {"--solver-tolerance", "1e-10"}}) {
     std::vector<std::string> args = {"train", "pixel-pendulum", "--out", (dir / "run").string()};
     args.insert(args.end(), option.begin(), option.end());
@@ -213,7 +213,9 @@ TEST(SampledFitCli, AnExplicitRcondIsUsedAsGiven) {
     const bool given = std::string(rcond) != "auto";
     EXPECT_EQ(fit.at("rcond"), given ? json(1e-3) : json("auto"));
     EXPECT_EQ(fit.at("rcond_validation").empty(), given);
-    if (given) EXPECT_EQ(fit.at("rcond_used").get<double>(), 1e-3);
+    if (given) {
+      EXPECT_EQ(fit.at("rcond_used").get<double>(), 1e-3);
+    }
     EXPECT_NE(r.out.find(given ? "(qr, rcond 0.001)" : "auto chose"), std::string::npos) << r.out;
   }
 }
