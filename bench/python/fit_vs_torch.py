@@ -4,7 +4,7 @@ Adam lr 1e-3 with weight decay 1e-4, 2000 steps, 2 threads). Prints one JSON lin
 reference's: ms per step around the training loop alone, final train and test loss.
 
   PYTHONPATH=build/apps/python /usr/bin/python3 bench/python/fit_vs_torch.py \\
-      /work/shared/reference/spring_seed0.f64 [float32|float64] [STEPS]
+      ../shared/reference/spring_seed0.f64 [float32|float64] [STEPS]
 
 docs/python.md gives the farm-bench command that runs it beside the reference.
 """
