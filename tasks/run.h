@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "tasks/evaluate/reversibility.h"
+#include "tasks/evaluate/run_warnings.h"
 #include "tasks/options.h"
 #include "tasks/task.h"
 
@@ -33,16 +34,6 @@ nlohmann::json run_training(const RunOptions& options);
 /// `hnn train`'s folder without --out: runs/TASK/MODEL, or runs/TASK/STEM/MODEL for a data file
 /// STEM.EXT, so that the runs of two files do not share a folder.
 std::filesystem::path default_run_folder(const RunOptions& options);
-
-/// The test R^2 below which a run is said to explain almost nothing of dx/dt.
-inline constexpr double kLowR2 = 0.1;
-
-/// metrics.json's "warnings": each a sentence about a run that ended no better than it started.
-/// Two tests: the loss curve's last test loss (its train loss where a task has no test loss) is
-/// not below its first recorded one, and the test R^2 (where a task reports one) is below
-/// kLowR2. An empty curve (a run evaluated again) skips the first.
-std::vector<std::string> run_warnings(const std::vector<CurvePoint>& curve,
-                                      const nlohmann::json& metrics);
 
 /// A finished run loaded back: its settings, its task and the run (data and trained model).
 struct LoadedRun {

@@ -4,8 +4,6 @@
 // one (--hamiltonian) also by the energy MSE of the other tasks.
 
 #include <algorithm>
-#include <cmath>
-#include <optional>
 
 #include "physics/expression_system.h"
 #include "physics/integrator.h"

@@ -144,6 +144,36 @@ bool wait_until(F done, double seconds) {
 }
 
 /// The lines of `text` (without their newlines).
+struct BadOption {
+  std::vector<std::string> args;  // after `hnn`; a train run's --out is appended
+  std::string message;            // the whole line after "hnn: error: "
+};
+
+/// A bad command: exit 1, its one line on stderr (CLI11's own parse errors end with a pointer to
+/// --help), nothing on stdout.
+inline void expect_one_line_error(const Result& r, const std::string& message,
+                                  const std::string& what) {
+  EXPECT_EQ(r.code, 1) << what;
+  const std::string line = "hnn: error: " + message;
+  EXPECT_TRUE(r.err == line + "\n" || r.err == line + " (see --help)\n")
+      << what << "\n  got:    " << r.err << "  wanted: " << line;
+  EXPECT_EQ(r.out, "") << what;
+}
+
+/// Each bad `hnn train` command, run with --quiet --out DIR/run: its one line, and no run folder.
+inline void expect_refused_with_no_run_folder(const std::vector<BadOption>& cases) {
+  const TempDir dir;
+  for (const BadOption& bad : cases) {
+    std::vector<std::string> args = bad.args;
+    const fs::path out = dir / "run";
+    args.insert(args.end(), {"--quiet", "--out", out.string()});
+    std::string what;
+    for (const std::string& a : bad.args) what += a + " ";
+    expect_one_line_error(run_hnn(args, dir.path()), bad.message, what);
+    EXPECT_FALSE(fs::exists(out)) << what;
+  }
+}
+
 inline std::vector<std::string> lines(const std::string& text) {
   std::vector<std::string> out;
   std::istringstream in(text);

@@ -27,6 +27,72 @@ Result train_spring(const TempDir& dir, const std::string& name, std::vector<std
   return run_hnn(args, dir.path());
 }
 
+// --fit sampled takes no steps: the options of Adam's steps are refused with it; its own options
+// are refused without it (docs/inputs.md).
+std::vector<BadOption> bad_fit_options() {
+  const std::string no_steps =
+      " does not apply to --fit sampled: it takes no training steps (the hidden layers are "
+      "sampled, the last layer solved); --fit sampled+adam fine-tunes with Adam from there";
+  std::vector<BadOption> bad;
+  for (const std::vector<std::string>& option :
+       std::vector<std::vector<std::string>>{{"--steps", "10"},
+                                             {"--batch", "10"},
+                                             {"--lr", "0.1"},
+                                             {"--lr-schedule", "cosine"},
+                                             {"--checkpoint-every", "5"}}) {
+    bad.push_back(
+        {{"train", "spring", "--fit", "sampled", option[0], option[1]}, option[0] + no_steps});
+  }
+  for (const std::vector<std::string>& option :
+       std::vector<std::vector<std::string>>{{"--sampler", "elm"},
+                                             {"--rcond", "1e-10"},
+                                             {"--solver", "qr"},
+                                             {"--regularization", "1e-8"},
+                                             {"--solver-tolerance", "1e-8"},
+                                             {"--solver-iterations", "50"}}) {
+    bad.push_back({{"train", "spring", option[0], option[1]},
+                   "spring: " + option[0] +
+                       " applies to a sampled fit only (add --fit sampled or --fit sampled+adam)"});
+  }
+  const std::vector<BadOption> others = {
+      {{"train", "spring", "--fit", "sampled", "--loss", "rollout"},
+       "spring: --loss rollout does not apply to --fit sampled (the last layer is solved on dx/dt "
+       "targets; --fit sampled+adam fine-tunes through the integrator)"},
+      {{"train", "double-pendulum", "--model", "lnn", "--fit", "sampled+adam"},
+       "double-pendulum: --fit sampled+adam does not fit an lnn: its accelerations are not linear "
+       "in its last layer (they invert the Hessian of L in dq/dt), so no least-squares solve "
+       "gives it (models it fits: hnn, baseline, dhnn)"},
+      {{"train", "spring", "--hidden", "5000"},
+       "--hidden 5000 is wider than Adam trains (4096 at most); --fit sampled takes up to 8192"},
+      {{"train", "spring", "--fit", "sampled", "--model", "baseline", "--hidden", "1000"},
+       "spring: sampled fit: 1000 last-layer unknowns per output but only 750 equations from 750 "
+       "points; lower the width or give more points"},
+      {{"train", "spring", "--fit", "sgd"}, "--fit: sgd not in {adam,sampled,sampled+adam}"},
+      {{"train", "spring", "--fit", "sampled", "--sampler", "gauss"},
+       "--sampler: gauss not in {elm,uswim,aswim}"},
+      {{"train", "spring", "--fit", "sampled", "--solver", "svd"},
+       "--solver: svd not in {lsqr,cholesky,qr}"},
+      {{"train", "spring", "--fit", "sampled", "--rcond", "1"},
+       "--rcond: expected auto or a number in (0, 1), got '1'"},
+      {{"train", "spring", "--fit", "sampled", "--rcond", "often"},
+       "--rcond: expected auto or a number in (0, 1), got 'often'"},
+      {{"train", "spring", "--fit", "sampled", "--settings", R"({"rcond": "often"})"},
+       "spring: --rcond must be auto or a number in (0, 1), got \"often\""},
+      {{"train", "spring", "--fit", "sampled", "--settings", R"({"rcond": 2})"},
+       "spring: --rcond must be in (0, 1), got 2"},
+      {{"train", "spring", "--fit", "sampled", "--regularization", "0"},
+       "--regularization: expected a finite number > 0, got '0'"},
+      {{"train", "spring", "--fit", "sampled", "--solver-iterations", "0"},
+       "--solver-iterations: Value 0 not in range 1 to 100000"},
+  };
+  bad.insert(bad.end(), others.begin(), others.end());
+  return bad;
+}
+
+TEST(SampledFitCli, BadFitOptionsGetOneLineAndNoRunFolder) {
+  expect_refused_with_no_run_folder(bad_fit_options());
+}
+
 TEST(SampledFitCli, ASampledSpringHnnIsAnOrdinaryRunFolderThatKeepsTheEnergyAdvantage) {
   const TempDir dir;
   // The spring's dx/dt are noisy: --rcond auto (the default) cuts off the singular values that
