@@ -85,7 +85,8 @@ def _fit(self, x, target, *, loss="derivative", fit="adam", seed=0, callback=Non
     Ctrl-C stops after the current step, raising KeyboardInterrupt with the model at that step.
     fit="sampled" (the derivative loss; not an LNN) samples the hidden layers from the data and
     solves the last layer by least squares, without backpropagation: sampler (uswim, aswim,
-    elm), rcond, solver (lsqr, cholesky, qr), regularization, solver_tolerance,
+    elm), rcond ("auto", the default, or a number), solver (qr, the default; lsqr, cholesky),
+    regularization, solver_tolerance,
     solver_iterations as `hnn train --fit sampled` takes them; its history is the one loss
     after the solve. fit="sampled+adam" samples, then trains with Adam as fit="adam".
     The GIL is released while it trains."""

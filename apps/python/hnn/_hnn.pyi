@@ -1,7 +1,7 @@
 # Types of the compiled module _hnn (apps/python/model_fit.cpp, systems.cpp, runs.cpp,
 # module.cpp), for editors; tests/python/hnn_test.py checks it names every public member.
 from os import PathLike
-from typing import Callable, Optional, Sequence
+from typing import Callable, Optional, Sequence, Union
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -52,7 +52,7 @@ class Model:
             callback: Optional[Callable[[int, float], object]] = None, steps: int = 1000,
             lr: float = 1e-3, batch: int = 0, record_every: int = 1, weight_decay: float = 0.0,
             horizon: int = 1, integrator: str = "rk4", dt: float = 0.0, sampler: str = "uswim",
-            rcond: float = 1e-13, solver: str = "lsqr", regularization: float = 1e-13,
+            rcond: Union[str, float] = "auto", solver: str = "qr", regularization: float = 1e-13,
             solver_tolerance: float = 1e-14, solver_iterations: int = 200) -> np.ndarray: ...
     def rollout(self, x0: ArrayLike, t: ArrayLike, integrator: str = "dopri5",
                 rtol: float = 1e-9, dt: float = 1e-2) -> np.ndarray: ...
