@@ -212,9 +212,9 @@ class Types(unittest.TestCase):
         self.assertEqual(public - named - {"systems", "_systems"} - set(dir(object)), set())
 
 
-    def test_the_package_stubs_name_every_public_name(self):
-        def stub_names(stub):
-            with open(os.path.join(os.path.dirname(hnn.__file__), stub + ".pyi")) as f:
+    def test_the_type_hint_files_name_every_public_name(self):
+        def pyi_names(pyi):
+            with open(os.path.join(os.path.dirname(hnn.__file__), pyi + ".pyi")) as f:
                 tree = ast.parse(f.read())
             names = {n.name for n in ast.walk(tree)
                      if isinstance(n, (ast.FunctionDef, ast.ClassDef))}
@@ -224,12 +224,12 @@ class Types(unittest.TestCase):
             return names | {a.asname for n in ast.walk(tree) if isinstance(n, ast.ImportFrom)
                             for a in n.names if a.asname}
 
-        for module, stub in ((hnn, "__init__"), (hnn.systems, "systems"),
+        for module, pyi in ((hnn, "__init__"), (hnn.systems, "systems"),
                              (hnn.autodiff, "autodiff"), (hnn.runs, "runs")):
-            with self.subTest(module=stub):
-                self.assertEqual(set(module.__all__) - stub_names(stub), set())
+            with self.subTest(module=pyi):
+                self.assertEqual(set(module.__all__) - pyi_names(pyi), set())
         run_members = {n for n in vars(hnn.Run) if not n.startswith("_")} | {"path", "metrics"}
-        self.assertEqual(run_members - stub_names("runs"), set())
+        self.assertEqual(run_members - pyi_names("runs"), set())
 
     def test_every_public_name_has_a_docstring(self):
         modules = [hnn, hnn.systems, hnn.autodiff]
