@@ -11,7 +11,7 @@
 #include "tasks/data/file_digest.h"
 #include "tasks/data/initial_states.h"
 #include "tasks/experiments/registry.h"
-#include "tasks/fit_options.h"
+#include "tasks/options/fit_options.h"
 #include "tasks/report/json_values.h"
 #include "tasks/train/checkpoint.h"
 

@@ -11,7 +11,7 @@
 #include "apps/python/model.h"
 #include "nn/sampled/sampled_fit.h"
 #include "tasks/error.h"
-#include "tasks/fit_options.h"
+#include "tasks/options/fit_options.h"
 #include "tasks/train/field_objective.h"
 #include "tasks/train/fit_method.h"
 #include "tasks/train/loop.h"

@@ -15,7 +15,7 @@
 #include "apps/python/interrupt.h"
 #include "autodiff/parallel.h"
 #include "tasks/run.h"
-#include "tasks/train_options.h"
+#include "tasks/options/train_options.h"
 
 namespace hnn::python {
 

@@ -1,6 +1,6 @@
 #pragma once
 // hnn.train's compiled half: `hnn train`'s run from Python options, through the same option
-// table (tasks/train_options.h) and run (tasks/run.h run_training).
+// table (tasks/options/train_options.h) and run (tasks/run.h run_training).
 
 #include <pybind11/pybind11.h>
 

@@ -16,7 +16,7 @@ namespace hnn::tasks {
 
 namespace {
 
-// In --help's order (tasks/train_options.cpp lists them).
+// In --help's order (tasks/options/train_options.cpp lists them).
 constexpr nn::NameTable<RolloutIntegrator, 4> kIntegratorNames{{
     {RolloutIntegrator::kLeapfrog, "leapfrog"},
     {RolloutIntegrator::kYoshida4, "yoshida4"},

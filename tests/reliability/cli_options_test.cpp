@@ -9,7 +9,7 @@
 #include "reliability_util.h"
 #include "tasks/experiments/registry.h"
 #include "tasks/run.h"
-#include "tasks/train_options.h"
+#include "tasks/options/train_options.h"
 
 namespace hnn::reliability {
 namespace {
@@ -190,7 +190,7 @@ TEST(CliOptions, ARunThatEndsNoBetterThanItStartedIsWarnedAbout) {
   }
 }
 
-// ---- the table of `hnn train`'s options (tasks/train_options.h) makes each of its forms -------
+// ---- the table of `hnn train`'s options (tasks/options/train_options.h) makes each of its forms -------
 
 using nlohmann::json;
 using tasks::TrainOption;

@@ -8,7 +8,7 @@
 
 #include "nn/sampled/sampled_fit.h"
 #include "reliability_util.h"
-#include "tasks/fit_options.h"
+#include "tasks/options/fit_options.h"
 #include "tasks/run.h"
 #include "tasks/train/stop.h"
 

@@ -20,7 +20,7 @@
 #include "apps/hnn/commands/validators.h"
 #include "tasks/experiments/registry.h"
 #include "tasks/run.h"
-#include "tasks/train_options.h"
+#include "tasks/options/train_options.h"
 
 namespace hnn::app {
 

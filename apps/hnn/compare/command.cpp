@@ -145,7 +145,7 @@ std::vector<Group> study(const CompareOptions& o) {
   return groups;
 }
 
-// The sweep keys of Adam's steps (tasks/fit_options.h, adam_option_given): a protocol's, left
+// The sweep keys of Adam's steps (tasks/options/fit_options.h, adam_option_given): a protocol's, left
 // out of a row fitted by sampling alone, which takes no steps.
 constexpr std::array<const char*, 5> kAdamKeys = {"steps", "batch", "lr", "lr-schedule",
                                                   "checkpoint-every"};

@@ -1,4 +1,4 @@
-// The spec's keys, `hnn train`'s options as its table declares them (tasks/train_options.h): each
+// The spec's keys, `hnn train`'s options as its table declares them (tasks/options/train_options.h): each
 // value checked as JSON by its kind, written as `hnn train` arguments and in run folder names.
 
 #include "apps/hnn/sweep/keys.h"

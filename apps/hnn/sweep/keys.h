@@ -1,6 +1,6 @@
 #pragma once
 // The keys of `hnn sweep`'s spec: the options of `hnn train` that its table
-// (tasks/train_options.h) makes sweep keys, each value checked as JSON, written as `hnn train`
+// (tasks/options/train_options.h) makes sweep keys, each value checked as JSON, written as `hnn train`
 // arguments and in run folder names.
 
 #include <nlohmann/json.hpp>
@@ -8,7 +8,7 @@
 #include <string_view>
 #include <vector>
 
-#include "tasks/train_options.h"
+#include "tasks/options/train_options.h"
 
 namespace hnn::app::sweep {
 

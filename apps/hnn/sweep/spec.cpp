@@ -18,7 +18,7 @@
 #include <stdexcept>
 
 #include "apps/hnn/sweep/keys.h"
-#include "tasks/fit_options.h"
+#include "tasks/options/fit_options.h"
 #include "tasks/options.h"
 #include "tasks/run.h"
 

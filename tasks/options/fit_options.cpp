@@ -1,4 +1,4 @@
-#include "tasks/fit_options.h"
+#include "tasks/options/fit_options.h"
 
 #include <utility>
 

@@ -1,7 +1,7 @@
 // The table of `hnn train`'s options (train_options.h); apply(), where each lands, is in
 // train_options_apply.cpp.
 
-#include "tasks/train_options.h"
+#include "tasks/options/train_options.h"
 
 #include <fmt/format.h>
 
