@@ -3,6 +3,7 @@
 
 #include <Eigen/Dense>
 #include <cmath>
+#include <numbers>
 #include <stdexcept>
 
 #include "physics/constrained/systems.h"
@@ -46,6 +47,17 @@ Batch chain_angles(int links, const Batch& cartesian) {
     }
   }
   return out;
+}
+
+void unwrap_angles(std::vector<Batch>& states, int links) {
+  for (std::size_t k = 1; k < states.size(); ++k) {
+    for (Eigen::Index r = 0; r < states[k].rows(); ++r) {
+      for (int c = 0; c < links; ++c) {
+        const double jump = states[k](r, c) - states[k - 1](r, c);
+        states[k](r, c) -= 2.0 * std::numbers::pi * std::round(jump / (2.0 * std::numbers::pi));
+      }
+    }
+  }
 }
 
 ChainPendulumAngles::ChainPendulumAngles(Eigen::VectorXd masses, Eigen::VectorXd lengths, double g)

@@ -14,6 +14,11 @@ Batch chain_cartesian(const Eigen::VectorXd& lengths, const Batch& angles_and_ra
 /// omega_k = (r x u) / |r|^2, with r, u link k's relative position and velocity.
 Batch chain_angles(int links, const Batch& cartesian);
 
+/// Makes the angle columns (0..links-1) of each row continuous along time, in place: each
+/// step's jump is brought into (-pi, pi] by whole turns, so chunks of a trajectory that crosses
+/// theta = pi carry no 2 pi jumps (chain_angles returns angles in (-pi, pi]).
+void unwrap_angles(std::vector<Batch>& states, int links);
+
 /// x = (theta, p) with canonical momenta p = M(theta) omega, where
 /// M_ab = mu_ab l_a l_b cos(theta_a - theta_b), mu_ab = sum_{k >= max(a, b)} m_k;
 /// H = p^T M^-1 p / 2 - g sum_k m_k sum_{a <= k} l_a cos theta_a, the Cartesian chain's energy

@@ -213,7 +213,19 @@ Trajectory simulate_constrained(const ConstrainedSystem& system, const Batch& z0
   IntegratorOptions options;
   options.rtol = rtol;
   options.atol = atol;
-  return Dopri5(options).integrate(system.field(), z0, t_eval);
+  const Dopri5 dopri5(options);
+  const VectorField field = system.field();
+  Trajectory out;
+  out.t = t_eval;
+  out.states.assign(t_eval.size(), Batch(z0.rows(), z0.cols()));
+  for (Eigen::Index r = 0; r < z0.rows(); ++r) {
+    const Trajectory row = dopri5.integrate(field, z0.row(r), t_eval);
+    for (std::size_t k = 0; k < t_eval.size(); ++k) out.states[k].row(r) = row.states[k];
+    out.stats.steps += row.stats.steps;
+    out.stats.rejected += row.stats.rejected;
+    out.stats.nfev += row.stats.nfev;
+  }
+  return out;
 }
 
 }  // namespace hnn::physics::constrained

@@ -47,7 +47,7 @@ TEST(ConstrainedTruth, ConstraintsAndEnergyHoldAlongTheTruthOfEverySystem) {
       energy = std::max(
           energy, ((system.hamiltonian_batch(z) - e0).array().abs() / scale.array()).maxCoeff());
     }
-    std::printf("%-20s max |phi| %.1e  max |J v| %.1e  max energy drift %.1e  (%ld steps)\n",
+    std::printf("%-20s max |phi| %.1e  max |J v| %.1e  max energy drift %.1e  (%ld steps in all)\n",
                 name.c_str(), phi, phi_dot, energy, truth.stats.steps);
     EXPECT_LT(phi, 5e-9);
     EXPECT_LT(phi_dot, 5e-8);
@@ -178,7 +178,10 @@ TEST(ChainAngles, GivesTheCartesianChainsTrajectoryForTwoLinks) {
   const ChainPendulumAngles angles(2);
   const ConstrainedSystem& cartesian = angles.cartesian();
   std::mt19937_64 rng(9);
-  const Batch z0 = cartesian.sample_initial_states(3, rng);
+  Batch z0(4, 8);
+  z0.topRows(3) = cartesian.sample_initial_states(3, rng);
+  // And one that swings over the top, through theta = pi, where chain_angles wraps.
+  z0.bottomRows(1) = chain_cartesian(chain_pendulum_lengths(2), Batch{{3.0, 3.0, 4.0, 4.0}});
   const Batch x0 = angles.from_cartesian(z0);
   EXPECT_LT(max_abs(angles.to_cartesian(x0) - z0), 1e-12);
   EXPECT_LT(max_abs(angles.hamiltonian_batch(x0) - cartesian.hamiltonian_batch(z0)), 1e-10);
@@ -191,6 +194,18 @@ TEST(ChainAngles, GivesTheCartesianChainsTrajectoryForTwoLinks) {
   double gap = 0.0;
   for (std::size_t k = 0; k < times.size(); ++k)
     gap = std::max(gap, max_abs(angles.to_cartesian(in_angles.states[k]) - in_cartesian.states[k]));
+  // The angles read back from the Cartesian path, made continuous, are the angle path's.
+  std::vector<Batch> read_back;
+  for (const Batch& z : in_cartesian.states) read_back.push_back(chain_angles(2, z));
+  unwrap_angles(read_back, 2);
+  double angle_gap = 0.0, largest_angle = 0.0;
+  for (std::size_t k = 0; k < times.size(); ++k) {
+    angle_gap =
+        std::max(angle_gap, max_abs(read_back[k].leftCols(2) - in_angles.states[k].leftCols(2)));
+    largest_angle = std::max(largest_angle, max_abs(in_angles.states[k].leftCols(2)));
+  }
+  EXPECT_LT(angle_gap, 1e-6);
+  EXPECT_GT(largest_angle, 3.5);  // the path goes past pi, where chain_angles wraps
   std::printf("two-link chain, angles vs Cartesian over %.1f s: max |dz| %.1e\n", times.back(),
               gap);
   EXPECT_LT(gap, 1e-6);
