@@ -159,6 +159,34 @@ TEST(ConstrainedSystems, RigidBodyKineticEnergyIsTheInertiaTensors) {
   EXPECT_LT((w_cross + w_cross.transpose()).cwiseAbs().maxCoeff(), 1e-14);
 }
 
+TEST(ConstrainedSystems, SamplersPlaceTheBodiesAsThePeers) {
+  std::mt19937_64 rng(8);
+  const Batch magnet = magnet_pendulum().sample_initial_states(200, rng);
+  EXPECT_LT(magnet.col(2).mean(), -0.9);  // hangs down over the magnets, near (0, 0, -1)
+  EXPECT_LT(magnet.col(0).cwiseAbs().mean(), 0.3);
+  const Batch coupled = coupled_pendulums(3).sample_initial_states(200, rng);
+  for (int b = 0; b < 3; ++b) EXPECT_NEAR(coupled.col(3 * b).mean(), b, 0.1);  // below (b, 0, 0)
+  const Batch gyro = gyroscope().sample_initial_states(200, rng);
+  EXPECT_GT(gyro.col(2).minCoeff(), 0.0);  // the centre stands above the tip at the origin
+  EXPECT_NEAR(gyro.col(2).maxCoeff(), 0.2217, 1e-3);
+}
+
+TEST(ConstrainedSystems, EulerFrameIsScipysZxzAndItsDerivative) {
+  const Eigen::Vector3d angles(0.3, -1.1, 2.0), rates(0.7, -0.4, 1.9);
+  Eigen::Matrix3d r, r_dot, scipy;
+  // Rotation.from_euler('ZXZ', [0.3, -1.1, 2.0]).as_matrix()
+  scipy << -0.5194486858736262, -0.812901851411958, -0.2633697832234624, 0.2710523527349594,
+      -0.44904755445759154, 0.8514029104439915, -0.810372559271972, 0.37087312359709634,
+      0.4535961214255772;
+  euler_frame(angles, rates, r, r_dot);
+  EXPECT_LT((r - scipy).cwiseAbs().maxCoeff(), 1e-15);
+  constexpr double h = 1e-6;
+  Eigen::Matrix3d plus, minus, unused;
+  euler_frame(angles + h * rates, rates, plus, unused);
+  euler_frame(angles - h * rates, rates, minus, unused);
+  EXPECT_LT((r_dot - (plus - minus) / (2.0 * h)).cwiseAbs().maxCoeff(), 1e-9);
+}
+
 TEST(ChainAngles, TwoLinkFieldIsTheDoublePendulums) {
   const ChainPendulumAngles chain(Eigen::Vector2d(1.0, 1.0), Eigen::Vector2d(1.0, 1.0), 9.81);
   const DoublePendulum reference;
