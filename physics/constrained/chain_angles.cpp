@@ -93,26 +93,71 @@ Eigen::VectorXd ChainPendulumAngles::hamiltonian_batch(const Batch& x) const {
   return h;
 }
 
-// dtheta/dt = omega = M^-1 p; dp_c/dt = -dH/dtheta_c = omega^T (dM/dtheta_c) omega / 2 -
-// dV/dtheta_c = -sum_b mu_cb l_c l_b omega_c omega_b sin(theta_c - theta_b) - g mu_cc l_c sin
-// theta_c.
+// dp_c/dt = -dH/dtheta_c = omega^T (dM/dtheta_c) omega / 2 - dV/dtheta_c
+// = -sum_b mu_cb l_c l_b omega_c omega_b sin(theta_c - theta_b) - g mu_cc l_c sin theta_c.
+Eigen::VectorXd ChainPendulumAngles::momentum_rate(const Eigen::VectorXd& theta,
+                                                   const Eigen::VectorXd& omega) const {
+  const int n = links();
+  Eigen::VectorXd rate(n);
+  for (int c = 0; c < n; ++c) {
+    rate[c] = -g_ * masses_.tail(n - c).sum() * lengths_[c] * std::sin(theta[c]);
+    for (int b = 0; b < n; ++b) {
+      const double mu = masses_.tail(n - std::max(b, c)).sum();
+      rate[c] -=
+          mu * lengths_[c] * lengths_[b] * omega[c] * omega[b] * std::sin(theta[c] - theta[b]);
+    }
+  }
+  return rate;
+}
+
+// d omega/dt from p = M omega: M alpha = dp/dt - (dM/dt) omega, where
+// dM_ab/dt = -mu_ab l_a l_b sin(theta_a - theta_b) (omega_a - omega_b).
+Eigen::VectorXd ChainPendulumAngles::angular_acceleration(const Eigen::VectorXd& theta,
+                                                          const Eigen::VectorXd& omega) const {
+  const int n = links();
+  Eigen::MatrixXd m_dot(n, n);
+  for (int a = 0; a < n; ++a)
+    for (int b = 0; b < n; ++b)
+      m_dot(a, b) = -masses_.tail(n - std::max(a, b)).sum() * lengths_[a] * lengths_[b] *
+                    std::sin(theta[a] - theta[b]) * (omega[a] - omega[b]);
+  return mass_matrix(theta).ldlt().solve(momentum_rate(theta, omega) - m_dot * omega);
+}
+
 void ChainPendulumAngles::vector_field(const Batch& x, Batch& dxdt) const {
   const int n = links();
   dxdt.resize(x.rows(), 2 * n);
   for (Eigen::Index r = 0; r < x.rows(); ++r) {
     const Eigen::VectorXd theta = x.row(r).head(n).transpose(), p = x.row(r).tail(n).transpose();
     const Eigen::VectorXd omega = mass_matrix(theta).ldlt().solve(p);
-    for (int c = 0; c < n; ++c) {
-      double force = -g_ * masses_.tail(n - c).sum() * lengths_[c] * std::sin(theta[c]);
-      for (int b = 0; b < n; ++b) {
-        const double mu = masses_.tail(n - std::max(b, c)).sum();
-        force -=
-            mu * lengths_[c] * lengths_[b] * omega[c] * omega[b] * std::sin(theta[c] - theta[b]);
-      }
-      dxdt(r, c) = omega[c];
-      dxdt(r, n + c) = force;
-    }
+    dxdt.row(r).head(n) = omega.transpose();
+    dxdt.row(r).tail(n) = momentum_rate(theta, omega).transpose();
   }
+}
+
+ChainPendulumVelocities::ChainPendulumVelocities(ChainPendulumAngles canonical)
+    : canonical_(std::move(canonical)) {}
+
+Eigen::VectorXd ChainPendulumVelocities::hamiltonian_batch(const Batch& x) const {
+  return canonical_.hamiltonian_batch(canonical_.momenta_from_velocities(x));
+}
+
+void ChainPendulumVelocities::vector_field(const Batch& x, Batch& dxdt) const {
+  const int n = canonical_.links();
+  dxdt.resize(x.rows(), 2 * n);
+  for (Eigen::Index r = 0; r < x.rows(); ++r) {
+    const Eigen::VectorXd theta = x.row(r).head(n).transpose(),
+                          omega = x.row(r).tail(n).transpose();
+    dxdt.row(r).head(n) = omega.transpose();
+    dxdt.row(r).tail(n) = canonical_.angular_acceleration(theta, omega).transpose();
+  }
+}
+
+Batch ChainPendulumVelocities::sample_initial_states(int n, std::mt19937_64& rng) const {
+  return chain_angles(canonical_.links(), canonical_.cartesian().sample_initial_states(n, rng));
+}
+
+Batch ChainPendulumVelocities::to_cartesian(const Batch& x) const {
+  return chain_cartesian(canonical_.lengths(), x);
 }
 
 Batch ChainPendulumAngles::momenta_from_velocities(const Batch& angles_and_rates) const {

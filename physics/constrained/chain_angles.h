@@ -39,6 +39,12 @@ class ChainPendulumAngles : public System {
 
   /// M(theta) for one state.
   Eigen::MatrixXd mass_matrix(const Eigen::VectorXd& theta) const;
+  /// dp/dt = -dH/dtheta at (theta, omega = M^-1 p).
+  Eigen::VectorXd momentum_rate(const Eigen::VectorXd& theta, const Eigen::VectorXd& omega) const;
+  /// d omega/dt, the Euler-Lagrange equations solved for the accelerations.
+  Eigen::VectorXd angular_acceleration(const Eigen::VectorXd& theta,
+                                       const Eigen::VectorXd& omega) const;
+  const Eigen::VectorXd& lengths() const { return lengths_; }
   Batch momenta_from_velocities(const Batch& angles_and_rates) const;
   Batch velocities_from_momenta(const Batch& x) const;
   /// (theta, p) rows -> Cartesian (x, v) rows, to measure angle models in the Cartesian metric.
@@ -52,6 +58,29 @@ class ChainPendulumAngles : public System {
   Eigen::VectorXd masses_, lengths_;
   double g_;
   ConstrainedSystem cartesian_;
+};
+
+/// The same chain in angles and angular velocities x = (theta, omega), as a Lagrangian NN learns
+/// it (like DoublePendulumVelocities): dx/dt = (omega, angular_acceleration). Not canonical:
+/// hamiltonian_batch is the energy.
+class ChainPendulumVelocities : public System {
+ public:
+  explicit ChainPendulumVelocities(ChainPendulumAngles canonical);
+  explicit ChainPendulumVelocities(int links)
+      : ChainPendulumVelocities(ChainPendulumAngles(links)) {}
+
+  int dim() const override { return canonical_.dim(); }
+  std::string name() const override { return canonical_.cartesian().name() + "_velocities"; }
+  Eigen::VectorXd hamiltonian_batch(const Batch& x) const override;
+  void vector_field(const Batch& x, Batch& dxdt) const override;
+  /// The Cartesian chain's sampler mapped to (theta, omega).
+  Batch sample_initial_states(int n, std::mt19937_64& rng) const override;
+  /// (theta, omega) rows -> Cartesian (x, v) rows.
+  Batch to_cartesian(const Batch& x) const;
+  const ChainPendulumAngles& canonical() const { return canonical_; }
+
+ private:
+  ChainPendulumAngles canonical_;
 };
 
 }  // namespace hnn::physics::constrained

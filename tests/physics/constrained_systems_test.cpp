@@ -202,6 +202,25 @@ TEST(ChainAngles, TwoLinkFieldIsTheDoublePendulums) {
   EXPECT_NEAR(shift[1], -3.0 * 9.81, 1e-12);
 }
 
+TEST(ChainAngles, VelocityFormFollowsTheCanonicalFieldForThreeLinks) {
+  // d omega/dt of the Lagrangian form equals d/dt (M^-1 p) along the canonical field, by a
+  // central difference of omega along the canonical flow's tangent.
+  const ChainPendulumVelocities lagrangian(3);
+  const ChainPendulumAngles& canonical = lagrangian.canonical();
+  std::mt19937_64 rng(6);
+  const Batch w = lagrangian.sample_initial_states(2, rng);
+  const Batch x = canonical.momenta_from_velocities(w);
+  Batch dw, dx;
+  lagrangian.vector_field(w, dw);
+  canonical.vector_field(x, dx);
+  constexpr double h = 1e-6;
+  const Batch ahead = canonical.velocities_from_momenta(x + h * dx);
+  const Batch behind = canonical.velocities_from_momenta(x - h * dx);
+  EXPECT_LT(max_abs(dw - (ahead - behind) / (2.0 * h)), 1e-6 * (1.0 + max_abs(dw)));
+  EXPECT_LT(max_abs(lagrangian.hamiltonian_batch(w) - canonical.hamiltonian_batch(x)), 1e-12);
+  EXPECT_LT(max_abs(lagrangian.to_cartesian(w) - canonical.to_cartesian(x)), 1e-12);
+}
+
 TEST(ChainAngles, GivesTheCartesianChainsTrajectoryForTwoLinks) {
   const ChainPendulumAngles angles(2);
   const ConstrainedSystem& cartesian = angles.cartesian();
