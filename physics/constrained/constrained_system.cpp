@@ -88,7 +88,8 @@ void ConstrainedSystem::add_distance_rows(const double* x, const double* v, Line
   const int d = spec_.dim;
   // One tethered or two-point squared distance: r = x_i - (x_j or anchor), u its velocity.
   const auto add = [&](int i, int j, const double* anchor, double length) {
-    Eigen::VectorXd r(d), u(d);
+    // At most 3 coordinates: on the stack, not the heap (this runs in every field call).
+    Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 3, 1> r(d), u(d);
     for (int k = 0; k < d; ++k) {
       r[k] = x[i * d + k] - (j >= 0 ? x[j * d + k] : anchor[k]);
       u[k] = v[i * d + k] - (j >= 0 ? v[j * d + k] : 0.0);
