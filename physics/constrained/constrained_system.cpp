@@ -186,21 +186,22 @@ Batch ConstrainedSystem::acceleration(const Batch& z) const {
 // of a numerical solution is the integrator's error alone (the multiplier form would let a
 // velocity error grow phi linearly in time).
 void ConstrainedSystem::vector_field(const Batch& z, Batch& dzdt) const {
-  const int n = configuration_dim(), c = constraint_count();
+  const int n = configuration_dim();
   dzdt.resize(z.rows(), 2 * n);
   for (Eigen::Index r = 0; r < z.rows(); ++r) {
     const Linearization lin = linearize(&z(r, 0), &z(r, n));
     const Eigen::VectorXd v = z.row(r).segment(n, n).transpose();
     const Eigen::VectorXd free = -inverse_mass_full_ * potential_gradient(&z(r, 0));
-    Eigen::MatrixXd gx(2 * c, n), gv = Eigen::MatrixXd::Zero(2 * c, n);
-    gx << lin.jacobian, lin.h;
-    gv.bottomRows(c) = lin.jacobian;
-    const Eigen::MatrixXd minv_gxt = inverse_mass_full_ * gx.transpose();
-    const Eigen::MatrixXd minv_gvt = inverse_mass_full_ * gv.transpose();
-    const Eigen::MatrixXd s = gx * minv_gvt - gv * minv_gxt;
-    const Eigen::VectorXd mu = s.partialPivLu().solve(-(gx * v + gv * free));
-    dzdt.row(r).head(n) = (v + minv_gvt * mu).transpose();
-    dzdt.row(r).tail(n) = (free - minv_gxt * mu).transpose();
+    // The system for mu = (mu1, mu2) is [[0, A], [-A, B]] mu = -(J v, H v + J M^-1 f) with
+    // A = J M^-1 J^T and B = H M^-1 J^T - J M^-1 H^T: two solves with A's factors.
+    const Eigen::MatrixXd minv_jt = inverse_mass_full_ * lin.jacobian.transpose();
+    const Eigen::MatrixXd minv_ht = inverse_mass_full_ * lin.h.transpose();
+    const Eigen::LDLT<Eigen::MatrixXd> a(lin.jacobian * minv_jt);
+    const Eigen::MatrixXd b = lin.h * minv_jt - lin.jacobian * minv_ht;
+    const Eigen::VectorXd mu2 = a.solve(-lin.jv);
+    const Eigen::VectorXd mu1 = a.solve(b * mu2 + lin.h * v + lin.jacobian * free);
+    dzdt.row(r).head(n) = (v + minv_jt * mu2).transpose();
+    dzdt.row(r).tail(n) = (free - minv_jt * mu1 - minv_ht * mu2).transpose();
   }
 }
 
