@@ -230,4 +230,26 @@ Trajectory simulate_constrained(const ConstrainedSystem& system, const Batch& z0
   return out;
 }
 
+ChunkSample sample_chunks(const ConstrainedSystem& system, int n, int chunk_len,
+                          std::mt19937_64& rng, double rtol) {
+  const std::vector<double> times = system.output_times();
+  const auto outputs = static_cast<int>(times.size());
+  if (chunk_len < 1 || outputs % chunk_len != 0)
+    throw std::invalid_argument(
+        fmt::format("sample_chunks: '{}' has {} outputs, not a multiple "
+                    "of the chunk length {}",
+                    system.name(), outputs, chunk_len));
+  const Trajectory full =
+      simulate_constrained(system, system.sample_initial_states(n, rng), times, rtol);
+  std::uniform_int_distribution<int> chunk(0, outputs / chunk_len - 1);
+  ChunkSample out;
+  out.states.assign(chunk_len, Batch(n, system.dim()));
+  for (int r = 0; r < n; ++r) {
+    out.first_output.push_back(chunk_len * chunk(rng));
+    for (int k = 0; k < chunk_len; ++k)
+      out.states[k].row(r) = full.states[out.first_output.back() + k].row(r);
+  }
+  return out;
+}
+
 }  // namespace hnn::physics::constrained

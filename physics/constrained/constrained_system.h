@@ -125,4 +125,16 @@ Trajectory simulate_constrained(const ConstrainedSystem& system, const Batch& z0
                                 const std::vector<double>& t_eval, double rtol = 1e-10,
                                 double atol = 1e-12);
 
+/// The peer's data states (RigidBodyDataset): n trajectories from the sampler at output_times(),
+/// each cut into consecutive chunks of chunk_len outputs, one chunk kept per trajectory at random.
+/// Its test starts are the first states of such chunks, not the sampled states: over 100 starts
+/// the magnet pendulum's floor is 4.40e-4 from chunk starts and 6.3e-4 from sampled ones (the
+/// peer published 4.45e-4).
+struct ChunkSample {
+  std::vector<Batch> states;      ///< chunk_len batches of n rows, dt apart
+  std::vector<int> first_output;  ///< per row, the index in output_times() of its chunk's start
+};
+ChunkSample sample_chunks(const ConstrainedSystem& system, int n, int chunk_len,
+                          std::mt19937_64& rng, double rtol = 1e-10);
+
 }  // namespace hnn::physics::constrained

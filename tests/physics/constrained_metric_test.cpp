@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <set>
 
 #include "physics/constrained/metric.h"
 #include "physics/constrained/systems.h"
@@ -65,6 +66,21 @@ TEST(ConstrainedMetric, FloorOfTheTwoLinkChainStartsOnTheManifoldNearTheTruth) {
   EXPECT_GT(floor.score.geometric_mean, 1e-6);
   EXPECT_LT(floor.score.geometric_mean, 1e-3);
   EXPECT_THROW(floor_score(system, z0, {truth.front()}, rng), std::invalid_argument);
+}
+
+TEST(ConstrainedData, ChunksAreConsecutiveTruthFromRandomStarts) {
+  const ConstrainedSystem system = magnet_pendulum();
+  std::mt19937_64 rng(1);
+  const ChunkSample sample = sample_chunks(system, 6, 5, rng);
+  ASSERT_EQ(sample.states.size(), 5u);
+  std::set<int> starts(sample.first_output.begin(), sample.first_output.end());
+  EXPECT_GT(starts.size(), 1u);  // random chunks, not all the first
+  for (int start : starts) EXPECT_TRUE(start % 5 == 0 && start >= 0 && start < 100);
+  // Each chunk is the truth from its first state, dt apart.
+  const Trajectory again = simulate_constrained(system, sample.states.front(),
+                                                {0.0, system.spec().dt, 2 * system.spec().dt});
+  EXPECT_LT((again.states[2] - sample.states[2]).cwiseAbs().maxCoeff(), 1e-7);
+  EXPECT_THROW(sample_chunks(system, 2, 3, rng), std::invalid_argument);  // 100 % 3 != 0
 }
 
 }  // namespace
