@@ -17,7 +17,8 @@ inline constexpr Eigen::Index kNarrow = 16;
 /// Elements of the narrow path's B^T on the stack (80 KiB of double): kNarrow x 640.
 inline constexpr Eigen::Index kStackedNarrow = kNarrow * 640;
 
-/// Call once before the first gemm: OpenBLAS must not start threads of its own.
+/// Keeps OpenBLAS from starting threads of its own under the calling thread: gemm calls it on
+/// every thread (Note [One BLAS thread per engine thread] in gemm.cpp).
 void init_gemm();
 
 template <typename A, typename B, typename C>
@@ -28,6 +29,7 @@ void gemm(const A& a, bool ta, const B& b, bool tb, C&& c, typename A::Scalar be
   eigen_assert((ta ? a.cols() : a.rows()) == m && (tb ? b.rows() : b.cols()) == n &&
                (tb ? b.cols() : b.rows()) == k);
 #ifdef HNN_HAVE_OPENBLAS
+  init_gemm();
   const auto op = [](bool t) { return t ? CblasTrans : CblasNoTrans; };
   const int lda = int(a.outerStride()), ldc = int(c.outerStride());
   int ldb = int(b.outerStride());
