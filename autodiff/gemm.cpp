@@ -4,6 +4,9 @@
 
 #include <mutex>
 
+#include "autodiff/check.h"
+#include "autodiff/flop_count.h"
+
 namespace hnn::ad::detail {
 
 // Note [One BLAS thread per engine thread]: the engine splits batches over its own threads, so
@@ -24,4 +27,23 @@ void init_gemm() {
 #endif
 }
 
+std::atomic<bool> g_counting_flops{false};
+
+namespace {
+std::atomic<std::uint64_t> g_flops{0};
+}
+
+void count_flops(std::uint64_t flops) { g_flops.fetch_add(flops, std::memory_order_relaxed); }
+
 }  // namespace hnn::ad::detail
+
+namespace hnn::ad {
+
+GemmFlopCounter::GemmFlopCounter() {
+  HNN_AD_CHECK(!detail::g_counting_flops.exchange(true), "GemmFlopCounter: one at a time");
+  detail::g_flops.store(0);
+}
+GemmFlopCounter::~GemmFlopCounter() { detail::g_counting_flops.store(false); }
+std::uint64_t GemmFlopCounter::flops() const { return detail::g_flops.load(); }
+
+}  // namespace hnn::ad
