@@ -5,6 +5,8 @@
 // across threads themselves), Eigen's otherwise.
 
 #include <Eigen/Core>
+#include <atomic>
+#include <cstdint>
 
 #ifdef HNN_HAVE_OPENBLAS
 #include <cblas.h>
@@ -17,8 +19,13 @@ inline constexpr Eigen::Index kNarrow = 16;
 /// Elements of the narrow path's B^T on the stack (80 KiB of double): kNarrow x 640.
 inline constexpr Eigen::Index kStackedNarrow = kNarrow * 640;
 
-/// Call once before the first gemm: OpenBLAS must not start threads of its own.
+/// Keeps OpenBLAS from starting threads of its own under the calling thread: gemm calls it on
+/// every thread (Note [One BLAS thread per engine thread] in gemm.cpp).
 void init_gemm();
+
+/// Whether a GemmFlopCounter (flop_count.h) is alive, and its count.
+extern std::atomic<bool> g_counting_flops;
+void count_flops(std::uint64_t flops);
 
 template <typename A, typename B, typename C>
 void gemm(const A& a, bool ta, const B& b, bool tb, C&& c, typename A::Scalar beta = 0) {
@@ -27,7 +34,9 @@ void gemm(const A& a, bool ta, const B& b, bool tb, C&& c, typename A::Scalar be
   const Eigen::Index m = c.rows(), n = c.cols(), k = ta ? a.rows() : a.cols();
   eigen_assert((ta ? a.cols() : a.rows()) == m && (tb ? b.rows() : b.cols()) == n &&
                (tb ? b.cols() : b.rows()) == k);
+  if (g_counting_flops.load(std::memory_order_relaxed)) count_flops(std::uint64_t(2 * m * n * k));
 #ifdef HNN_HAVE_OPENBLAS
+  init_gemm();
   const auto op = [](bool t) { return t ? CblasTrans : CblasNoTrans; };
   const int lda = int(a.outerStride()), ldc = int(c.outerStride());
   int ldb = int(b.outerStride());

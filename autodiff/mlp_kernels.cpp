@@ -219,7 +219,6 @@ void input_gradient_rows(const MlpLayers<T>& l, Node<T>& node, int j, RowBlock r
 
 template <typename T>
 void tanh_mlp_forward(const MlpLayers<T>& l, Node<T>& node) {
-  init_gemm();
   const int L = l.count();
   const Index rows = l.x().rows();
   node.buffers.resize(std::size_t(L - 1));
@@ -237,7 +236,6 @@ void tanh_mlp_forward(const MlpLayers<T>& l, Node<T>& node) {
 
 template <typename T>
 void input_gradient_forward(const MlpLayers<T>& l, Node<T>& node) {
-  init_gemm();
   const int L = l.count();
   const GradientBuffers at{L, l.outputs()};
   const Index rows = l.x().rows();

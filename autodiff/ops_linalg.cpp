@@ -13,7 +13,6 @@ namespace {
 // the output's rows (or, for a short wide output, its columns) split over the engine's threads.
 template <typename T>
 void product(const Matrix<T>& a, const Matrix<T>& b, bool ta, bool tb, Matrix<T>& out) {
-  detail::init_gemm();
   const Eigen::Index m = ta ? a.cols() : a.rows(), n = tb ? b.rows() : b.cols();
   out.resize(m, n);
   if ((ta ? a.rows() : a.cols()) == 0) {

@@ -1,6 +1,6 @@
 #pragma once
 // The engine's worker threads: fused kernels and big ops split a batch into row blocks, one per
-// thread. Workers are created once; between jobs they watch for the next one for 50 us, then
+// thread. Workers are created once; between jobs they watch for the next one for 500 us, then
 // sleep (futex waits), so jobs in quick succession cost no wake-up and an idle pool steals no
 // shared machine's cores (Note [Brief spin] in parallel.cpp).
 

@@ -7,7 +7,7 @@ packages=(
   build-essential cmake ninja-build pkg-config
   libeigen3-dev libfmt-dev libcli11-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  libgif-dev libpng-dev libopenblas-pthread-dev libxtensor-dev libzip-dev libginac-dev libyaml-cpp-dev
+  libgif-dev libpng-dev libopenblas-pthread-dev libopenblas0-openmp libxtensor-dev libzip-dev libginac-dev libyaml-cpp-dev
   libssl-dev
   python3-matplotlib python3-numpy python3-distributed
   pybind11-dev python3-dev python3-pytest

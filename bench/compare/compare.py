@@ -16,17 +16,17 @@ import datetime
 import json
 import os
 import platform
-import statistics
 import subprocess
 import sys
 import time
 from pathlib import Path
 
+from report import IMPLS, best_against_best, markdown, summarise
+
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent.parent
 OPENBLAS_OPENMP = "/usr/lib/x86_64-linux-gnu/openblas-openmp"
 MALLOC_TUNABLES = "glibc.malloc.mmap_threshold=16777216:glibc.malloc.trim_threshold=268435456"
-IMPLS = ("hnn", "pytorch", "libtorch")
 
 # name: (task, model, dtype, timing steps[, options of every program]). Steps are short enough
 # for a shared machine; the spring loss check runs the full 2000 separately.
@@ -174,35 +174,40 @@ def command(impl, progs, args, case, data, init, threads, steps):
 
 # ---- the runs -----------------------------------------------------------------------------
 def time_cases(args, progs, cases, data, inits):
+    """Every case at every thread count with every implementation, in alternation: within a
+    round each case runs at each thread count in turn, so a change in the machine's load
+    shows in both thread counts alike."""
     runs = []
     impls = [i for i in IMPLS if i in progs]
-    for threads in args.threads:
-        env = tuned_env(args, threads)
-        for rnd in range(args.rounds):
-            for case in cases:
-                # Alternate, and rotate the order each round so no implementation always
-                # follows the same neighbour.
+    for rnd in range(args.rounds):
+        for case in cases:
+            # Rotate the orders each round so no run always follows the same neighbour.
+            threads_order = args.threads[rnd % len(args.threads):] + args.threads[:rnd % len(args.threads)]
+            for threads in threads_order:
                 order = impls[rnd % len(impls):] + impls[:rnd % len(impls)]
                 steps = max(20, int(CASES[case][3] * args.steps_scale))
                 for impl in order:
                     if impl == "libtorch" and case in PEERS:
-                        if threads == args.threads[0] and rnd == 0:
-                            log(f"  {case}: no LibTorch program for the peers' cases (skipped)")
                         continue
-                    cmd = command(impl, progs, args, case, data[CASES[case][0]], inits[case],
-                                  threads, steps)
-                    load = os.getloadavg()[0]
-                    try:
-                        r = run_json(cmd, env, timeout=args.timeout)
-                    except (RuntimeError, subprocess.TimeoutExpired) as error:
-                        log(f"  {impl} {case}: {error}")
-                        continue
-                    r.update(case=case, round=rnd, load_before=load)
-                    runs.append(r)
-                    log(f"  {case:24s} t={threads} round {rnd} {impl:9s} "
-                        f"{r['ms_per_step']:9.3f} ms/step  train {r['train_loss']:.6g}  "
-                        f"load {load:.1f}")
+                    r = time_one(args, progs, case, data, inits, impl, threads, steps)
+                    if r is not None:
+                        r.update(round=rnd)
+                        runs.append(r)
     return runs
+
+
+def time_one(args, progs, case, data, inits, impl, threads, steps):
+    cmd = command(impl, progs, args, case, data[CASES[case][0]], inits[case], threads, steps)
+    load = os.getloadavg()[0]
+    try:
+        r = run_json(cmd, tuned_env(args, threads), timeout=args.timeout)
+    except (RuntimeError, subprocess.TimeoutExpired) as error:
+        log(f"  {impl} {case}: {error}")
+        return None
+    r.update(case=case, load_before=load)
+    log(f"  {case:24s} t={threads} {impl:9s} {r['ms_per_step']:9.3f} ms/step  "
+        f"train {r['train_loss']:.6g}  load {load:.1f}")
+    return r
 
 
 def peer_checks(cases):
@@ -257,92 +262,41 @@ def loss_check(args, progs, data, out, cases):
     return checks
 
 
-# ---- the report ---------------------------------------------------------------------------
-def summarise(runs, cases, threads_list):
-    rows = []
-    for threads in threads_list:
-        for case in cases:
-            row = {"case": case, "threads": threads}
-            for impl in IMPLS:
-                mine = [r for r in runs if r["case"] == case and r["threads"] == threads
-                        and r["impl"] == impl]
-                if mine:
-                    row[impl] = {"ms": statistics.median(r["ms_per_step"] for r in mine),
-                                 "runs": [round(r["ms_per_step"], 4) for r in mine],
-                                 "train_loss": statistics.median(r["train_loss"] for r in mine),
-                                 "test_loss": statistics.median(r["test_loss"] for r in mine)}
-            if "hnn" in row:
-                for impl in ("pytorch", "libtorch"):
-                    if impl in row:
-                        row[f"{impl}/hnn"] = row[impl]["ms"] / row["hnn"]["ms"]
-            rows.append(row)
-    return rows
-
-
-def fmt_ms(row, impl):
-    return f"{row[impl]['ms']:.3f}" if impl in row else "-"
-
-
-def peer_markdown(checks):
-    """The peers' float64 losses side by side, with their relative difference."""
-    lines = ["", "Same computation: the peers' cases in float64 from hnn's initial parameters "
-             "(train and test loss after the timing steps, 1 thread):", "",
-             "| case | steps | train loss hnn | train loss PyTorch | test loss hnn | "
-             "test loss PyTorch | largest relative difference |", "| --- | --- | --- | --- | --- | --- | --- |"]
-    for case in dict.fromkeys(c["case"] for c in checks):
-        by = {c["impl"]: c for c in checks if c["case"] == case}
-        if "hnn" not in by or "pytorch" not in by:
-            continue
-        h, t = by["hnn"], by["pytorch"]
-        rel = max(abs(h[k] - t[k]) / max(abs(h[k]), abs(t[k]), 1e-300)
-                  for k in ("train_loss", "test_loss"))
-        lines.append(f"| {case} | {h['steps']} | {h['train_loss']:.15g} | {t['train_loss']:.15g} "
-                     f"| {h['test_loss']:.15g} | {t['test_loss']:.15g} | {rel:.1e} |")
-    return lines
-
-
-def markdown(meta, rows, checks, peer_checks_run=()):
-    lines = [f"Measured {meta['date']} on {meta['cpu']} ({meta['cpus']} CPUs), hnn {meta['commit']};"
-             f" load average {meta['load_start']:.1f} at the start, {meta['load_end']:.1f} at the end;"
-             f" {meta['rounds']} rounds, medians; env: {meta['env']}.", "",
-             "| case | threads | hnn ms/step | PyTorch ms/step | LibTorch ms/step | PyTorch/hnn |"
-             " LibTorch/hnn | train loss hnn / PyTorch / LibTorch |",
-             "| --- | --- | --- | --- | --- | --- | --- | --- |"]
-    for row in rows:
-        ratio = lambda k: f"{row[k]:.2f}x" if k in row else "-"
-        losses = " / ".join(f"{row[i]['train_loss']:.4g}" if i in row else "-" for i in IMPLS)
-        lines.append(f"| {row['case']} | {row['threads']} | {fmt_ms(row, 'hnn')} | "
-                     f"{fmt_ms(row, 'pytorch')} | {fmt_ms(row, 'libtorch')} | "
-                     f"{ratio('pytorch/hnn')} | {ratio('libtorch/hnn')} | {losses} |")
-    if checks:
-        lines += ["", "Same computation: spring HNN, 2000 full-batch steps on "
-                  "spring_seed0.f64 from hnn's initial parameters (reference f32: train 0.0350,"
-                  " test 0.0404):", "", "| implementation | dtype | train loss | test loss |",
-                  "| --- | --- | --- | --- |"]
-        for c in checks:
-            lines.append(f"| {c['impl']} | {c['dtype']} | {c['train_loss']:.6g} | "
-                         f"{c['test_loss']:.6g} |")
-    if peer_checks_run:
-        lines += peer_markdown(peer_checks_run)
-    return "\n".join(lines) + "\n"
+def cpuinfo(field):
+    """The first value of a /proc/cpuinfo field, or None."""
+    try:
+        with open("/proc/cpuinfo") as f:
+            for line in f:
+                key, _, value = line.partition(":")
+                if key.strip() == field:
+                    return value.strip()
+    except OSError:
+        pass
+    return None
 
 
 def machine(args):
-    cpu = platform.processor() or "unknown CPU"
-    try:
-        with open("/proc/cpuinfo") as f:
-            names = [l.split(":", 1)[1].strip() for l in f if l.startswith("model name")]
-        cpu = names[0] if names else cpu
-    except OSError:
-        pass
     commit = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"],
                             capture_output=True, text=True).stdout.strip() or "unknown"
     dirty = subprocess.run(["git", "-C", ROOT, "status", "--porcelain", "--untracked-files=no"],
                            capture_output=True, text=True).stdout.strip()
-    return {"date": datetime.datetime.now().strftime("%Y-%m-%d %H:%M"), "cpu": cpu,
+    return {"date": datetime.datetime.now().strftime("%Y-%m-%d %H:%M"),
+            "cpu": cpuinfo("model name") or platform.processor() or "unknown CPU",
+            "cpu_family": cpuinfo("cpu family"), "cpu_model": cpuinfo("model"),
             "cpus": os.cpu_count(), "commit": commit + ("+local changes" if dirty else ""),
             "load_start": os.getloadavg()[0], "rounds": args.rounds,
             "env": f"OPENBLAS_CORETYPE={args.coretype}, openblas-openmp, malloc tunables"}
+
+
+def fma_peaks(args, hnn):
+    """The machine's FMA peak in GFLOP/s per dtype and thread count, measured by hnn_train_step
+    (a register-only FMA loop, bench/fma_peak.h): the steps' fractions of peak divide by it."""
+    peaks = {}
+    for dtype in ("float32", "float64"):
+        for threads in args.threads:
+            r = run_json([hnn, "--fma-peak", dtype, "--threads", threads], tuned_env(args, threads))
+            peaks.setdefault(dtype, {})[str(threads)] = r["fma_peak_gflops"]
+    return peaks
 
 
 def main():
@@ -393,16 +347,18 @@ def main():
     out.mkdir(parents=True, exist_ok=True)
     checked = [] if args.no_loss_check else peer_checks(cases)
     data, inits = prepare(args, hnn, cases + [c for c in checked if c not in cases], out)
+    meta["fma_peak_gflops"] = fma_peaks(args, hnn)
     started = time.time()
     runs = time_cases(args, progs, cases, data, inits)
     checks = [] if args.no_loss_check else loss_check(args, progs, data, out, cases)
     peers_checked = [] if args.no_loss_check else peer_loss_check(args, progs, data, inits, cases)
     meta.update(load_end=os.getloadavg()[0], minutes=(time.time() - started) / 60,
                 impls=[i for i in IMPLS if i in progs])
-    rows = summarise(runs, cases, args.threads)
-    report = markdown(meta, rows, checks, peers_checked)
+    rows = summarise(runs, cases, args.threads, meta["fma_peak_gflops"])
+    best = best_against_best(rows, cases)
+    report = markdown(meta, rows, best, checks, peers_checked)
     stamp = datetime.datetime.now().strftime("%Y%m%d-%H%M%S")
-    result = {"meta": meta, "summary": rows, "loss_check": checks,
+    result = {"meta": meta, "summary": rows, "best": best, "loss_check": checks,
               "peer_loss_check": peers_checked, "runs": runs}
     for name in (f"compare-{stamp}", "latest"):
         (out / f"{name}.json").write_text(json.dumps(result, indent=1) + "\n")

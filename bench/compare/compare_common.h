@@ -48,6 +48,7 @@ struct Options {
   std::string data, save_data, init, save_init;
   long n_train = -1, n_test = -1;  // rows of the data file's splits (spring: 750, 750)
   int pixel_trials = 20;           // frames of the pixel data: trials x 103
+  std::string fma_peak;            // hnn_train_step: float32|float64: print the FMA peak, exit
 };
 
 /// The state size of a task's model input.
@@ -141,8 +142,9 @@ inline Options parse_options(int argc, char** argv, const char* program) {
           "  [--batch N] [--seed N]\n"
           "  [--lr X] [--weight-decay X] [--dynamics-weight-decay X] [--pixel-trials N]\n"
           "  [--data FILE --n-train N --n-test N] [--save-data FILE] [--init FILE]\n"
-          "  [--save-init FILE]\nPrints one JSON line: ms_per_step (median over windows), "
-          "train_loss, test_loss.\n",
+          "  [--save-init FILE] [--fma-peak float32|float64]\nPrints one JSON line: ms_per_step "
+          "(median over windows), train_loss, test_loss (--fma-peak: the machine's FMA peak on\n"
+          "--threads threads instead).\n",
           program);
       std::exit(0);
     }
@@ -196,6 +198,8 @@ inline Options parse_options(int argc, char** argv, const char* program) {
       o.n_test = std::stol(v);
     else if (key == "--pixel-trials")
       o.pixel_trials = std::stoi(v);
+    else if (key == "--fma-peak")
+      o.fma_peak = v;
     else
       throw std::invalid_argument("unknown option " + key + " (see --help)");
   }

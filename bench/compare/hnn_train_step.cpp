@@ -11,16 +11,19 @@
 #include <fstream>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <random>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "autodiff/flop_count.h"
 #include "autodiff/grad.h"
 #include "autodiff/ops.h"
 #include "autodiff/parallel.h"
 #include "autodiff/tape.h"
 #include "bench/compare/compare_common.h"
+#include "bench/fma_peak.h"
 #include "nn/hnn.h"
 #include "nn/loss.h"
 #include "nn/optim.h"
@@ -250,16 +253,21 @@ json run(const cmp::Options& o, const cmp::Data& data) {
   for (const Batch& p : train) parts.push_back(p.cast<T>());
   cmp::BatchIndices indices(o.seed, parts[0].rows());
   cmp::StepTimer timer(o.steps, o.warmup, o.window);
+  std::uint64_t gemm_flops = 0;  // of the first (untimed) step
   for (int step = 0; step < o.steps; ++step) {
+    std::optional<ad::GemmFlopCounter> counter;
+    if (step == 0) counter.emplace();
     if (o.batch == 0) {
       model.step(parts);
     } else {
       gather(parts, indices, o.batch, batch);
       model.step(batch);
     }
+    if (counter) gemm_flops = counter->flops();
     timer.tick(step + 1);
   }
   json result = timer.to_json();
+  result["gemm_flops_per_step"] = gemm_flops;
   result["train_loss"] = model.mean_loss(train);
   result["test_loss"] = model.mean_loss(split_parts(o, data.test_x, data.test_dx));
   result["train_rows"] = parts[0].rows();  // windows, for the rollout loss
@@ -271,6 +279,19 @@ json run(const cmp::Options& o, const cmp::Data& data) {
 int main(int argc, char** argv) {
   try {
     const cmp::Options o = cmp::parse_options(argc, argv, "hnn_train_step");
+    if (!o.fma_peak.empty()) {
+      if (o.fma_peak != "float32" && o.fma_peak != "float64")
+        throw std::invalid_argument("--fma-peak takes float32 or float64, got " + o.fma_peak);
+      const bool single = o.fma_peak == "float32";
+      const double peak =
+          single ? hnn::bench::fma_peak<float>(o.threads) : hnn::bench::fma_peak<double>(o.threads);
+      std::printf("%s\n", json{{"fma_peak_gflops", peak / 1e9},
+                               {"threads", o.threads},
+                               {"dtype", single ? "float32" : "float64"}}
+                              .dump()
+                              .c_str());
+      return 0;
+    }
     ad::set_num_threads(o.threads);
     Eigen::setNbThreads(o.threads);
     const cmp::Data data = o.data.empty() ? build_data(o) : cmp::load_data(o);

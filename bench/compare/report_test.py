@@ -1,0 +1,54 @@
+"""The tables of report.py on hand-made runs (ctest bench.CompareReport)."""
+import unittest
+
+from report import best_against_best, markdown, summarise
+
+
+def run(impl, threads, ms, flops=None):
+    r = {"case": "c", "impl": impl, "threads": threads, "ms_per_step": ms, "dtype": "float32",
+         "train_loss": 1.0, "test_loss": 2.0}
+    if flops is not None:
+        r["gemm_flops_per_step"] = flops
+    return r
+
+
+class ReportTest(unittest.TestCase):
+    def setUp(self):
+        # hnn: 2 threads slower than 1; PyTorch: faster at 2.
+        runs = [run("hnn", 2, 3.0, 2e9), run("hnn", 1, 2.0, 2e9),
+                run("pytorch", 2, 5.0), run("pytorch", 1, 6.0)]
+        self.peaks = {"float32": {"1": 100.0, "2": 200.0}}
+        self.rows = summarise(runs, ["c"], [2, 1], self.peaks)
+        self.best = best_against_best(self.rows, ["c"])
+
+    def row(self, threads):
+        return next(r for r in self.rows if r["threads"] == threads)
+
+    def test_a_side_slower_on_two_threads_than_on_one_is_marked(self):
+        self.assertTrue(self.row(2)["hnn"]["slower_than_1"])
+        self.assertFalse(self.row(2)["pytorch"]["slower_than_1"])
+        self.assertNotIn("slower_than_1", self.row(1)["hnn"])
+
+    def test_best_against_best_takes_each_side_at_its_faster_thread_count(self):
+        b = self.best[0]
+        self.assertEqual((b["hnn"]["ms"], b["hnn"]["threads"]), (2.0, 1))
+        self.assertEqual((b["pytorch"]["ms"], b["pytorch"]["threads"]), (5.0, 2))
+        self.assertAlmostEqual(b["pytorch/hnn"], 2.5)
+
+    def test_fraction_of_peak_divides_the_gemm_flops_by_the_peak_at_that_thread_count(self):
+        # 2 GFLOP in 2 ms on 1 thread = 1000 GFLOP/s against a peak of 100: 10.
+        self.assertAlmostEqual(self.row(1)["hnn"]["of_peak"], 2e9 / (100e9 * 2e-3))
+        self.assertAlmostEqual(self.row(2)["hnn"]["of_peak"], 2e9 / (200e9 * 3e-3))
+
+    def test_the_markdown_names_the_machine_and_marks_the_slower_side(self):
+        meta = {"date": "d", "cpu": "AMD EPYC", "cpu_family": "25", "cpu_model": "17", "cpus": 2,
+                "commit": "abc", "load_start": 0.1, "load_end": 0.2, "rounds": 1, "env": "e",
+                "fma_peak_gflops": self.peaks}
+        text = markdown(meta, self.rows, self.best, [])
+        self.assertIn("AMD EPYC (family 25, model 17", text)
+        self.assertIn("3.000 (slower than 1 thread)", text)
+        self.assertIn("| c | 2.000 (1) | 5.000 (2) | 2.50x |", text)
+
+
+if __name__ == "__main__":
+    unittest.main()
