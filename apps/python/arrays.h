@@ -56,6 +56,7 @@ class StatesIn {
 /// How many state arrays states() has copied since the module was loaded: tests/python read it
 /// (hnn._hnn._state_copies) to check that an array read in place is not copied.
 extern std::atomic<long> state_copies;
+
 /// `obj` as a 3-D array [times, batch, dim] (as simulate and rollout return), one matrix
 /// [times, dim] per trajectory; throws InputError naming `what` like states().
 std::vector<physics::Batch> trajectories(const py::handle& obj, std::string_view what,

@@ -62,13 +62,31 @@ json canonical(const TrainOption& option, const json& value) {
   }
 }
 
+using Asked = std::vector<std::pair<const TrainOption*, json>>;
+
+// The options `hnn train --resume DIR` starts from (apps/hnn/commands/train.cpp): the run's own,
+// from its checkpoint, continued to the steps asked if any (the table's continues_resume);
+// refuses an option asked that could change the result (not the table's with_resume).
+tasks::RunOptions resumed(const std::string& run_dir, const Asked& asked) {
+  std::optional<int> steps;  // more steps: a finished run continued
+  for (const auto& [option, value] : asked) {
+    if (option->continues_resume) {
+      steps = canonical(*option, value).get<int>();
+    } else if (!option->with_resume) {
+      std::string name(option->name);
+      std::replace(name.begin(), name.end(), '-', '_');
+      throw InputError(fmt::format(
+          "{} cannot be combined with resume: a resumed run keeps its own settings", name));
+    }
+  }
+  return tasks::resume_options(run_dir, steps);
+}
+
 // The options of `hnn train TASK --name value...`, or with `resume` a folder, of `hnn train
-// --resume RESUME --name value...` (apps/hnn/commands/train.cpp): the run's own options from its
-// checkpoint, with on top only those given that cannot change its result (the table's
-// with_resume), and steps to continue a finished run (continues_resume).
+// --resume RESUME --name value...`: resumed()'s, with the options asked on top.
 tasks::RunOptions run_options(const std::string& task, const json& given,
                               const std::string& resume) {
-  std::vector<std::pair<const TrainOption*, json>> asked;
+  Asked asked;
   if (resume.empty()) asked.emplace_back(tasks::find_train_option("task"), task);
   if (!resume.empty() && !task.empty())
     throw InputError("task cannot be combined with resume: a resumed run keeps its own settings");
@@ -87,21 +105,7 @@ tasks::RunOptions run_options(const std::string& task, const json& given,
   std::sort(asked.begin(), asked.end(), [](const auto& a, const auto& b) {
     return std::less<const TrainOption*>()(a.first, b.first);
   });
-  tasks::RunOptions o;
-  if (!resume.empty()) {
-    std::optional<int> steps;  // more steps: a finished run continued
-    for (const auto& [option, value] : asked) {
-      if (option->continues_resume) {
-        steps = canonical(*option, value).get<int>();
-      } else if (!option->with_resume) {
-        std::string name(option->name);
-        std::replace(name.begin(), name.end(), '-', '_');
-        throw InputError(fmt::format(
-            "{} cannot be combined with resume: a resumed run keeps its own settings", name));
-      }
-    }
-    o = tasks::resume_options(resume, steps);
-  }
+  tasks::RunOptions o = resume.empty() ? tasks::RunOptions{} : resumed(resume, asked);
   for (const auto& [option, value] : asked) {
     if (const std::string why = tasks::not_applicable(*option, o.task); !why.empty())
       throw InputError(fmt::format("{} {}", option->name, why));
