@@ -16,7 +16,7 @@ Var<T> Var<T>::leaf(Matrix<T> value, bool requires_grad) {
 }
 
 template <typename T>
-Var<T> Var<T>::constant(const Matrix<T>& value) {
+Var<T> Var<T>::constant(const MatrixView<T>& value) {
   Node<T>& node = Tape<T>::current().push();
   node.op = "constant";
   node.value = value;
@@ -24,7 +24,7 @@ Var<T> Var<T>::constant(const Matrix<T>& value) {
 }
 
 template <typename T>
-Var<T> Var<T>::variable(const Matrix<T>& value) {
+Var<T> Var<T>::variable(const MatrixView<T>& value) {
   Node<T>& node = Tape<T>::current().push();
   node.op = "variable";
   node.value = value;

@@ -17,6 +17,11 @@ namespace hnn::ad {
 
 template <typename T>
 using Matrix = Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+/// A read-only view of a Matrix<T> or of rows of memory laid out like one (a C-contiguous NumPy
+/// array's buffer): what the entry points that only read their input take, so that a caller's
+/// buffer reaches them without a copy.
+template <typename T>
+using MatrixView = Eigen::Ref<const Matrix<T>>;
 
 template <typename T>
 class Var;
@@ -88,12 +93,12 @@ class Var {
   /// A persistent leaf (a parameter or an input to differentiate with respect to).
   static Var leaf(Matrix<T> value, bool requires_grad = true);
   /// A scratch constant on the tape: no gradient, buffer recycled with the tape.
-  static Var constant(const Matrix<T>& value);
+  static Var constant(const MatrixView<T>& value);
   /// A scratch variable on the tape: a constant() that requires gradients, so grad() can
   /// differentiate with respect to it (a batch of states a field is differentiated in). Recycled
   /// with the tape, so a warmed-up step allocates nothing, unlike a leaf(). Not a leaf:
   /// backward() accumulates nothing into it.
-  static Var variable(const Matrix<T>& value);
+  static Var variable(const MatrixView<T>& value);
   /// Wraps a node that is on the tape (used by backward formulas to refer to outputs).
   static Var of(const Node<T>& node) { return Var(const_cast<Node<T>*>(&node), nullptr); }
 

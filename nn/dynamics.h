@@ -91,8 +91,9 @@ class DynamicsModel : public Module<T> {
   /// NoGradGuard too, giving values only.
   virtual ad::Var<T> time_derivative(const ad::Var<T>& x) const = 0;
   /// f(x) as plain values, for rollouts and evaluation: records only what it needs, inside its
-  /// own TapeScope, whatever the grad mode.
-  virtual Matrix<T> field(const Matrix<T>& x) const = 0;
+  /// own TapeScope, whatever the grad mode. `x` is a view: a Matrix<T>, or a buffer laid out
+  /// like one (apps/python/arrays.h passes a NumPy array's without copying it).
+  virtual Matrix<T> field(const MatrixView<T>& x) const = 0;
 
   const DynamicsConfig& config() const { return config_; }
   Index dim() const { return config_.dim; }

@@ -57,7 +57,7 @@ ad::Var<T> Hnn<T>::energy(const ad::Var<T>& x) const {
 }
 
 template <typename T>
-Matrix<T> Hnn<T>::energy(const Matrix<T>& x) const {
+Matrix<T> Hnn<T>::energy(const MatrixView<T>& x) const {
   ad::TapeScope scope;
   ad::NoGradGuard values_only;
   return energy(ad::Var<T>::constant(x)).value();
@@ -107,7 +107,7 @@ ad::Var<T> Hnn<T>::time_derivative(const ad::Var<T>& x) const {
 }
 
 template <typename T>
-Matrix<T> Hnn<T>::field(const Matrix<T>& x) const {
+Matrix<T> Hnn<T>::field(const MatrixView<T>& x) const {
   this->check_input("field", x.rows(), x.cols());
   ad::TapeScope scope;
   ad::NoGradGuard values_only;
@@ -132,7 +132,7 @@ ad::Var<T> Baseline<T>::time_derivative(const ad::Var<T>& x) const {
 }
 
 template <typename T>
-Matrix<T> Baseline<T>::field(const Matrix<T>& x) const {
+Matrix<T> Baseline<T>::field(const MatrixView<T>& x) const {
   this->check_input("field", x.rows(), x.cols());
   ad::TapeScope scope;
   ad::NoGradGuard values_only;

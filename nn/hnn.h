@@ -32,14 +32,14 @@ class Hnn : public DynamicsModel<T> {
 
   /// The learned Hamiltonian H(x), R x 1 (the MLP's column 0); throws for kConservative.
   ad::Var<T> energy(const ad::Var<T>& x) const;
-  Matrix<T> energy(const Matrix<T>& x) const;
+  Matrix<T> energy(const MatrixView<T>& x) const;
   /// The learned dissipation potential D(x), R x 1; throws for kSolenoidal.
   ad::Var<T> dissipation(const ad::Var<T>& x) const;
 
   ad::Var<T> time_derivative(const ad::Var<T>& x) const override;
   /// Both parts separately (their sum is time_derivative).
   Parts time_derivative_parts(const ad::Var<T>& x) const;
-  Matrix<T> field(const Matrix<T>& x) const override;
+  Matrix<T> field(const MatrixView<T>& x) const override;
 
   template <typename U>
   Hnn<U> cast() const {
@@ -58,7 +58,7 @@ class Baseline : public DynamicsModel<T> {
   Baseline& operator=(Baseline&&) noexcept = default;
 
   ad::Var<T> time_derivative(const ad::Var<T>& x) const override;
-  Matrix<T> field(const Matrix<T>& x) const override;
+  Matrix<T> field(const MatrixView<T>& x) const override;
 
   template <typename U>
   Baseline<U> cast() const {

@@ -69,12 +69,13 @@ ad::Var<T> Lnn<T>::lagrangian(const ad::Var<T>& x) const {
 }
 
 template <typename T>
-Matrix<T> Lnn<T>::energy(const Matrix<T>& x) const {
-  this->check_input("energy", x.rows(), x.cols());
+Matrix<T> Lnn<T>::energy(const MatrixView<T>& states) const {
+  this->check_input("energy", states.rows(), states.cols());
   ad::TapeScope scope;
   ad::GradModeGuard record(true);
-  const Index n = x.cols() / 2;
-  const ad::Var<T> in = ad::Var<T>::leaf(x);
+  const Index n = states.cols() / 2;
+  const ad::Var<T> in = ad::Var<T>::leaf(states);
+  const Matrix<T>& x = in.value();  // the leaf's copy: the sums below read a Matrix, as before
   const Matrix<T> dl = this->input_gradient(in, 0).value();
   // The prior term's share, v · (v · slope) - |v~|² prior / 2, is |v~|² prior / 2.
   const Matrix<T> v2 = x.rightCols(n).array().square().matrix();
@@ -111,7 +112,7 @@ ad::Var<T> Lnn<T>::time_derivative(const ad::Var<T>& x) const {
 }
 
 template <typename T>
-Matrix<T> Lnn<T>::field(const Matrix<T>& x) const {
+Matrix<T> Lnn<T>::field(const MatrixView<T>& x) const {
   this->check_input("field", x.rows(), x.cols());
   ad::TapeScope scope;
   ad::NoGradGuard values_only;

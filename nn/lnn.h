@@ -25,12 +25,12 @@ class Lnn : public DynamicsModel<T> {
   /// The learned Lagrangian L(q, v), R x 1, the prior term included.
   ad::Var<T> lagrangian(const ad::Var<T>& x) const;
   /// The learned energy E = v · dL/dv - L, R x 1: what the learned motion conserves.
-  Matrix<T> energy(const Matrix<T>& x) const;
+  Matrix<T> energy(const MatrixView<T>& x) const;
 
   /// (v, dv/dt). Throws ad::Error naming the row when a block d²L/dv² is singular or
   /// ill-conditioned (the learned L has no well-defined motion there).
   ad::Var<T> time_derivative(const ad::Var<T>& x) const override;
-  Matrix<T> field(const Matrix<T>& x) const override;
+  Matrix<T> field(const MatrixView<T>& x) const override;
 
   template <typename U>
   Lnn<U> cast() const {

@@ -14,6 +14,8 @@ namespace hnn::nn {
 using Index = Eigen::Index;
 template <typename T>
 using Matrix = ad::Matrix<T>;
+template <typename T>
+using MatrixView = ad::MatrixView<T>;
 
 /// A parameter and its dotted path in the module tree ("layers.0.weight").
 template <typename T>

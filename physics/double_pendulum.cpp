@@ -19,7 +19,7 @@ DoublePendulum::DoublePendulum(double m1, double m2, double l1, double l2, doubl
 
 // With d = theta1 - theta2 and D = m1 + m2 sin^2 d (det M = m2 l1^2 l2^2 D):
 // T = N / (2 m2 l1^2 l2^2 D), N = m2 l2^2 p1^2 + (m1+m2) l1^2 p2^2 - 2 m2 l1 l2 p1 p2 cos d.
-Eigen::VectorXd DoublePendulum::hamiltonian_batch(const Batch& x) const {
+Eigen::VectorXd DoublePendulum::hamiltonian_batch(const BatchView& x) const {
   const Eigen::ArrayXd t1 = x.col(0).array(), t2 = x.col(1).array(), p1 = x.col(2).array(),
                        p2 = x.col(3).array();
   const Eigen::ArrayXd d = t1 - t2;
@@ -35,7 +35,7 @@ Eigen::VectorXd DoublePendulum::hamiltonian_batch(const Batch& x) const {
 
 // dp1/dt = -dV/dtheta1 - dT/dd with dT/dd = C1 - C2, C1 = p1 p2 sin d / (l1 l2 D),
 // C2 = N sin 2d / (2 l1^2 l2^2 D^2); dp2/dt = -dV/dtheta2 + dT/dd.
-void DoublePendulum::vector_field(const Batch& x, Batch& dxdt) const {
+void DoublePendulum::vector_field(const BatchView& x, Batch& dxdt) const {
   const Eigen::ArrayXd t1 = x.col(0).array(), t2 = x.col(1).array(), p1 = x.col(2).array(),
                        p2 = x.col(3).array();
   const Eigen::ArrayXd d = t1 - t2, c = d.cos(), s = d.sin();
@@ -91,7 +91,7 @@ DoublePendulumVelocities::DoublePendulumVelocities(double m1, double m2, double 
                                                    double g)
     : m1_(m1), m2_(m2), l1_(l1), l2_(l2), g_(g), canonical_(m1, m2, l1, l2, g) {}
 
-Eigen::VectorXd DoublePendulumVelocities::hamiltonian_batch(const Batch& x) const {
+Eigen::VectorXd DoublePendulumVelocities::hamiltonian_batch(const BatchView& x) const {
   const Eigen::ArrayXd t1 = x.col(0).array(), t2 = x.col(1).array(), w1 = x.col(2).array(),
                        w2 = x.col(3).array();
   const Eigen::ArrayXd kinetic = 0.5 * (m1_ + m2_) * l1_ * l1_ * w1.square() +
@@ -104,7 +104,7 @@ Eigen::VectorXd DoublePendulumVelocities::hamiltonian_batch(const Batch& x) cons
 
 // M(theta) alpha = f(theta, omega), M's rows normalised by their diagonals: alpha1 + a1 alpha2 =
 // f1 and a2 alpha1 + alpha2 = f2, solved in closed form (1 - a1 a2 = m1 / (m1 + m2 sin^2 d) > 0).
-void DoublePendulumVelocities::vector_field(const Batch& x, Batch& dxdt) const {
+void DoublePendulumVelocities::vector_field(const BatchView& x, Batch& dxdt) const {
   const Eigen::ArrayXd t1 = x.col(0).array(), t2 = x.col(1).array(), w1 = x.col(2).array(),
                        w2 = x.col(3).array();
   const Eigen::ArrayXd d = t1 - t2, c = d.cos(), s = d.sin();

@@ -24,8 +24,8 @@ class DoublePendulum : public System {
 
   int dim() const override { return 4; }
   std::string name() const override { return "double_pendulum"; }
-  Eigen::VectorXd hamiltonian_batch(const Batch& x) const override;
-  void vector_field(const Batch& x, Batch& dxdt) const override;
+  Eigen::VectorXd hamiltonian_batch(const BatchView& x) const override;
+  void vector_field(const BatchView& x, Batch& dxdt) const override;
   /// Not in docs/tasks.md: angles U[-pi/2, pi/2], angular velocities U[-1, 1].
   Batch sample_initial_states(int n, std::mt19937_64& rng) const override;
 
@@ -33,6 +33,13 @@ class DoublePendulum : public System {
   Batch momenta_from_velocities(const Batch& angles_and_velocities) const;
   /// The inverse: (theta1, theta2, p1, p2) -> (theta1, theta2, omega1, omega2).
   Batch velocities_from_momenta(const Batch& x) const;
+
+  /// The constructor's arguments.
+  struct Parameters {
+    double m1, m2, l1, l2, g;
+    PotentialZero zero;
+  };
+  Parameters parameters() const { return {m1_, m2_, l1_, l2_, g_, zero_}; }
 
  private:
   double m1_, m2_, l1_, l2_, g_;
@@ -52,8 +59,8 @@ class DoublePendulumVelocities : public System {
 
   int dim() const override { return 4; }
   std::string name() const override { return "double_pendulum_velocities"; }
-  Eigen::VectorXd hamiltonian_batch(const Batch& x) const override;
-  void vector_field(const Batch& x, Batch& dxdt) const override;
+  Eigen::VectorXd hamiltonian_batch(const BatchView& x) const override;
+  void vector_field(const BatchView& x, Batch& dxdt) const override;
   /// The LNN paper's test states: angles U[0, 2 pi), angular velocities U[0, 0.1).
   Batch sample_initial_states(int n, std::mt19937_64& rng) const override;
   /// The canonical system of the same pendulum, for conversions.

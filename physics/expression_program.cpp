@@ -15,7 +15,7 @@ using Op = Instruction::Op;
 
 // One instruction over a block; r(k) is register k's column.
 template <typename Registers>
-void execute(const Instruction& in, const Batch& x, Eigen::Index row0, Registers&& r, int out) {
+void execute(const Instruction& in, const BatchView& x, Eigen::Index row0, Registers&& r, int out) {
   auto y = r.col(out);
   const Eigen::Index m = y.rows();
   switch (in.op) {
@@ -129,11 +129,12 @@ void ExpressionProgram::add_output(int reg, std::string name) {
   output_names_.push_back(std::move(name));
 }
 
-void ExpressionProgram::run_block(const Batch& x, Eigen::Index row0, Eigen::ArrayXXd& reg) const {
+void ExpressionProgram::run_block(const BatchView& x, Eigen::Index row0,
+                                  Eigen::ArrayXXd& reg) const {
   for (int i = 0; i < size(); ++i) execute(code_[i], x, row0, reg, i);
 }
 
-void ExpressionProgram::evaluate(const Batch& x, Batch& out) const {
+void ExpressionProgram::evaluate(const BatchView& x, Batch& out) const {
   out.resize(x.rows(), outputs());
   Eigen::ArrayXXd reg(std::min(kBlockRows, x.rows()), size());
   for (Eigen::Index row0 = 0; row0 < x.rows(); row0 += kBlockRows) {

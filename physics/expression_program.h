@@ -67,10 +67,10 @@ class ExpressionProgram {
 
   /// out(i, k) = output k at state row i; out is resized to x.rows() x outputs(). Values may be
   /// non-finite: the caller checks (it knows what the outputs mean).
-  void evaluate(const Batch& x, Batch& out) const;
+  void evaluate(const BatchView& x, Batch& out) const;
 
  private:
-  void run_block(const Batch& x, Eigen::Index row0, Eigen::ArrayXXd& reg) const;
+  void run_block(const BatchView& x, Eigen::Index row0, Eigen::ArrayXXd& reg) const;
 
   std::vector<Instruction> code_;
   std::vector<int> outputs_;

@@ -8,6 +8,8 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <map>
+#include <mutex>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -127,6 +129,40 @@ std::string text_of(const GiNaC::ex& e) {
 
 }  // namespace
 
+// H parsed over one symbol per column.
+struct ExpressionSystem::Parsed {
+  std::vector<GiNaC::ex> symbols;
+  detail::ColumnOf column_of;
+  GiNaC::ex h;
+};
+
+namespace {
+
+using Parsed = ExpressionSystem::Parsed;
+
+Parsed parse(const std::string& expression, const std::vector<std::string>& names,
+             std::size_t coords) {
+  Parsed parsed;
+  for (const std::string& name : names) {
+    parsed.symbols.push_back(GiNaC::realsymbol(name));  // real: |q|' and conjugates simplify
+    parsed.column_of[parsed.symbols.back()] = int(parsed.symbols.size()) - 1;
+  }
+  parsed.h = parse_hamiltonian(expression, parsed.symbols, names, coords);
+  return parsed;
+}
+
+// d^k h / dx_i1 ... dx_ik for `sorted` = (i1 <= ... <= ik), each computed once in `memo`.
+const GiNaC::ex& partial(const Parsed& parsed, const std::vector<int>& sorted,
+                         std::map<std::vector<int>, GiNaC::ex>& memo) {
+  if (const auto seen = memo.find(sorted); seen != memo.end()) return seen->second;
+  const std::vector<int> rest(sorted.begin(), sorted.end() - 1);
+  const GiNaC::ex d =
+      partial(parsed, rest, memo).diff(GiNaC::ex_to<GiNaC::symbol>(parsed.symbols[sorted.back()]));
+  return memo.emplace(sorted, d).first->second;
+}
+
+}  // namespace
+
 ExpressionSystem::ExpressionSystem(std::string hamiltonian, std::vector<std::string> coords,
                                    std::vector<std::string> momenta, StateSampling sampling)
     : expression_(std::move(hamiltonian)),
@@ -161,13 +197,8 @@ ExpressionSystem::ExpressionSystem(std::string hamiltonian, std::vector<std::str
 void ExpressionSystem::compile() {
   const std::vector<std::string> names = variables();
   const std::size_t n = coords_.size();
-  std::vector<GiNaC::ex> symbols;
-  detail::ColumnOf column_of;
-  for (const std::string& name : names) {
-    symbols.push_back(GiNaC::realsymbol(name));  // real: |q|' and conjugates simplify
-    column_of[symbols.back()] = int(symbols.size()) - 1;
-  }
-  const GiNaC::ex h = parse_hamiltonian(expression_, symbols, names, n);
+  parsed_ = std::make_shared<const Parsed>(parse(expression_, names, n));
+  const auto& [symbols, column_of, h] = *parsed_;
   const std::vector<GiNaC::ex> q(symbols.begin(), symbols.begin() + long(n));
   const std::vector<GiNaC::ex> p(symbols.begin() + long(n), symbols.end());
   std::vector<detail::NamedExpression> drift, kick;
@@ -201,14 +232,14 @@ std::vector<std::string> ExpressionSystem::variables() const {
   return names;
 }
 
-void ExpressionSystem::check_columns(const Batch& x) const {
+void ExpressionSystem::check_columns(const BatchView& x) const {
   if (x.cols() != dim()) {
     throw std::invalid_argument(fmt::format("{}: state has {} columns, expected {} ({})", name(),
                                             x.cols(), dim(), joined(variables())));
   }
 }
 
-void ExpressionSystem::check_finite(const Batch& x, const Batch& out,
+void ExpressionSystem::check_finite(const BatchView& x, const Batch& out,
                                     const ExpressionProgram& program) const {
   if (out.allFinite()) return;
   Eigen::Index row = 0, k = 0;
@@ -224,7 +255,7 @@ void ExpressionSystem::check_finite(const Batch& x, const Batch& out,
                                           fmt::join(state, ", ")));
 }
 
-Eigen::VectorXd ExpressionSystem::hamiltonian_batch(const Batch& x) const {
+Eigen::VectorXd ExpressionSystem::hamiltonian_batch(const BatchView& x) const {
   check_columns(x);
   Batch h;
   h_.evaluate(x, h);
@@ -232,10 +263,44 @@ Eigen::VectorXd ExpressionSystem::hamiltonian_batch(const Batch& x) const {
   return h.col(0);
 }
 
-void ExpressionSystem::vector_field(const Batch& x, Batch& dxdt) const {
+void ExpressionSystem::vector_field(const BatchView& x, Batch& dxdt) const {
   check_columns(x);
   field_.evaluate(x, dxdt);
   check_finite(x, dxdt, field_);
+}
+
+Batch ExpressionSystem::derivatives(const BatchView& x, int order) const {
+  check_columns(x);
+  if (order < 0)
+    throw std::invalid_argument(
+        fmt::format("{}: derivative of order {} (0 or more)", name(), order));
+  const std::vector<std::string> names = variables();
+  const Parsed& parsed = *parsed_;
+  // GiNaC's expressions share reference counts without locks: one call at a time touches them
+  // (the evaluation below runs in parallel).
+  static std::mutex ginac;
+  std::unique_lock<std::mutex> lock(ginac);
+  std::map<std::vector<int>, GiNaC::ex> memo{{{}, parsed.h}};  // mixed partials commute
+  std::vector<detail::NamedExpression> outputs;
+  long entries = 1;
+  for (int k = 0; k < order; ++k) entries *= dim();
+  for (long entry = 0; entry < entries; ++entry) {
+    std::vector<int> index(static_cast<std::size_t>(order));  // i1..ik, ik running fastest
+    long rest = entry;
+    for (auto i = index.rbegin(); i != index.rend(); ++i, rest /= dim()) *i = int(rest % dim());
+    std::string what = order == 0 ? "H" : fmt::format("d^{} H /", order);
+    for (int i : index) what += " d" + names[std::size_t(i)];
+    std::sort(index.begin(), index.end());
+    outputs.push_back({std::move(what), partial(parsed, index, memo)});
+  }
+  const ExpressionProgram program = detail::compile_expressions(outputs, parsed.column_of, name());
+  memo.clear();
+  outputs.clear();
+  lock.unlock();
+  Batch out;
+  program.evaluate(x, out);
+  check_finite(x, out, program);
+  return out;
 }
 
 std::optional<SplitField> ExpressionSystem::separable_split() const {

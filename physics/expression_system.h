@@ -3,6 +3,7 @@
 // once into straight-line code in double that evaluates H and the field on whole batches.
 #pragma once
 
+#include <memory>
 #include <optional>
 #include <string>
 #include <utility>
@@ -39,8 +40,8 @@ class ExpressionSystem : public System {
   int dim() const override { return int(2 * coords_.size()); }
   /// "H = <the expression as given>".
   std::string name() const override;
-  Eigen::VectorXd hamiltonian_batch(const Batch& x) const override;
-  void vector_field(const Batch& x, Batch& dxdt) const override;
+  Eigen::VectorXd hamiltonian_batch(const BatchView& x) const override;
+  void vector_field(const BatchView& x, Batch& dxdt) const override;
   /// As StateSampling says; deterministic in rng. Throws std::invalid_argument when the
   /// energy band stays unfilled after max_draws.
   Batch sample_initial_states(int n, std::mt19937_64& rng) const override;
@@ -58,12 +59,20 @@ class ExpressionSystem : public System {
   std::vector<std::string> variables() const;
   /// dH/d(column j's variable), exact, as GiNaC prints it: "(9.81)*sin(q)" for d/dq above.
   const std::string& derivative_text(int column) const { return derivative_texts_.at(column); }
+  /// The order-th derivatives of H at each row of x, differentiated symbolically and compiled
+  /// for this call: R x dim^order, row r's entry d^order H / dx_i1 ... dx_ik at column
+  /// i1 dim^(order-1) + ... + ik (each new index last). Order 0 is H. Throws
+  /// std::invalid_argument for a negative order, or naming the state where one is not finite.
+  Batch derivatives(const BatchView& x, int order) const;
+
+  /// H and its symbols as GiNaC parsed them (defined in expression_system.cpp only).
+  struct Parsed;
 
  private:
   void compile();
-  void check_columns(const Batch& x) const;
+  void check_columns(const BatchView& x) const;
   // Throws naming the first state where an output of `program` is not finite.
-  void check_finite(const Batch& x, const Batch& out, const ExpressionProgram& program) const;
+  void check_finite(const BatchView& x, const Batch& out, const ExpressionProgram& program) const;
   Batch sample_box(int n, std::mt19937_64& rng) const;
 
   std::string expression_;
@@ -74,6 +83,9 @@ class ExpressionSystem : public System {
   bool separable_ = false;
   std::vector<std::string> derivative_texts_;
   ExpressionProgram h_, field_, drift_, kick_;
+  // H and its symbols as parsed, which derivatives() differentiates: the same symbols each
+  // call, so the same code and the same bits.
+  std::shared_ptr<const Parsed> parsed_;
 };
 
 }  // namespace hnn::physics

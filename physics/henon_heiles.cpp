@@ -13,7 +13,7 @@ HenonHeiles::HenonHeiles(double alpha, double half_width) : alpha_(alpha), half_
     throw std::invalid_argument("HenonHeiles half width must be finite and positive");
 }
 
-Eigen::VectorXd HenonHeiles::hamiltonian_batch(const Batch& x) const {
+Eigen::VectorXd HenonHeiles::hamiltonian_batch(const BatchView& x) const {
   const Eigen::ArrayXd q1 = x.col(0).array(), q2 = x.col(1).array();
   const Eigen::ArrayXd kinetic = (x.col(2).array().square() + x.col(3).array().square()) / 2.0;
   const Eigen::ArrayXd potential =

@@ -18,7 +18,7 @@ class HenonHeiles : public SeparableSystem {
 
   int dim() const override { return 4; }
   std::string name() const override { return "henon_heiles"; }
-  Eigen::VectorXd hamiltonian_batch(const Batch& x) const override;
+  Eigen::VectorXd hamiltonian_batch(const BatchView& x) const override;
   void velocity(const BatchView& p, BatchSpan dq) const override;
   void force(const BatchView& q, BatchSpan dp) const override;
   /// Uniform in [-half_width, half_width]^4.

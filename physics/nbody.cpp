@@ -46,7 +46,7 @@ int NBody::column(int body, int axis, bool momentum) const {
   return (momentum ? 2 * bodies() : 0) + axis * bodies() + body;
 }
 
-Eigen::VectorXd NBody::hamiltonian_batch(const Batch& x) const {
+Eigen::VectorXd NBody::hamiltonian_batch(const BatchView& x) const {
   const int n = bodies();
   Eigen::ArrayXd h = Eigen::ArrayXd::Zero(x.rows());
   for (int i = 0; i < n; ++i) {

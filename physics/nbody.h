@@ -23,7 +23,7 @@ class NBody : public SeparableSystem {
 
   int dim() const override { return 4 * bodies(); }
   std::string name() const override;
-  Eigen::VectorXd hamiltonian_batch(const Batch& x) const override;
+  Eigen::VectorXd hamiltonian_batch(const BatchView& x) const override;
   void velocity(const BatchView& p, BatchSpan dq) const override;
   void force(const BatchView& q, BatchSpan dp) const override;
   /// Two bodies: docs/tasks.md's near-circular orbits; three bodies: its perturbed

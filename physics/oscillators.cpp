@@ -20,7 +20,7 @@ Spring::Spring(double stiffness, double kinetic) : stiffness_(stiffness), kineti
   require_positive(kinetic, "Spring kinetic coefficient");
 }
 
-Eigen::VectorXd Spring::hamiltonian_batch(const Batch& x) const {
+Eigen::VectorXd Spring::hamiltonian_batch(const BatchView& x) const {
   return (stiffness_ * x.col(0).array().square() + kinetic_ * x.col(1).array().square()).matrix();
 }
 
@@ -36,24 +36,24 @@ DampedSpring::DampedSpring(double rho) : rho_(rho) {
   require_positive(rho, "DampedSpring damping rho");
 }
 
-Eigen::VectorXd DampedSpring::hamiltonian_batch(const Batch& x) const {
+Eigen::VectorXd DampedSpring::hamiltonian_batch(const BatchView& x) const {
   return (x.col(0).array().square() + x.col(1).array().square()).matrix();
 }
 
-Batch DampedSpring::conservative_part(const Batch& x) const {
+Batch DampedSpring::conservative_part(const BatchView& x) const {
   Batch f(x.rows(), 2);
   f.col(0) = 2.0 * x.col(1);
   f.col(1) = -2.0 * x.col(0);
   return f;
 }
 
-Batch DampedSpring::dissipative_part(const Batch& x) const {
+Batch DampedSpring::dissipative_part(const BatchView& x) const {
   Batch f = Batch::Zero(x.rows(), 2);
   f.col(0) = -rho_ * x.col(0);
   return f;
 }
 
-void DampedSpring::vector_field(const Batch& x, Batch& dxdt) const {
+void DampedSpring::vector_field(const BatchView& x, Batch& dxdt) const {
   dxdt = conservative_part(x) + dissipative_part(x);
 }
 
@@ -80,7 +80,7 @@ Pendulum::Pendulum(double potential, double kinetic) : potential_(potential), ki
   require_positive(kinetic, "Pendulum kinetic coefficient");
 }
 
-Eigen::VectorXd Pendulum::hamiltonian_batch(const Batch& x) const {
+Eigen::VectorXd Pendulum::hamiltonian_batch(const BatchView& x) const {
   return (potential_ * (1.0 - x.col(0).array().cos()) + kinetic_ * x.col(1).array().square())
       .matrix();
 }

@@ -14,7 +14,7 @@ class Spring : public SeparableSystem {
 
   int dim() const override { return 2; }
   std::string name() const override { return "spring"; }
-  Eigen::VectorXd hamiltonian_batch(const Batch& x) const override;
+  Eigen::VectorXd hamiltonian_batch(const BatchView& x) const override;
   void velocity(const BatchView& p, BatchSpan dq) const override;
   void force(const BatchView& q, BatchSpan dp) const override;
   /// Direction uniform in [-1,1]^2, normalised to radius r ~ U[0.1, 1.0].
@@ -24,6 +24,8 @@ class Spring : public SeparableSystem {
 
   /// Angular frequency 2 sqrt(stiffness * kinetic) (2 by default: period pi).
   double omega() const;
+  double stiffness() const { return stiffness_; }
+  double kinetic() const { return kinetic_; }
 
  private:
   double stiffness_;
@@ -38,7 +40,7 @@ class Pendulum : public SeparableSystem {
 
   int dim() const override { return 2; }
   std::string name() const override { return "pendulum"; }
-  Eigen::VectorXd hamiltonian_batch(const Batch& x) const override;
+  Eigen::VectorXd hamiltonian_batch(const BatchView& x) const override;
   void velocity(const BatchView& p, BatchSpan dq) const override;
   void force(const BatchView& q, BatchSpan dp) const override;
   /// Direction uniform in [-1,1]^2, normalised to radius r ~ U[1.3, 2.3].
@@ -46,6 +48,8 @@ class Pendulum : public SeparableSystem {
 
   /// Small-amplitude angular frequency sqrt(2 potential kinetic) (sqrt(6) by default).
   double small_angle_omega() const;
+  double potential() const { return potential_; }
+  double kinetic() const { return kinetic_; }
 
  private:
   double potential_;
@@ -62,11 +66,11 @@ class DampedSpring : public System {
 
   int dim() const override { return 2; }
   std::string name() const override { return "damped-spring"; }
-  Eigen::VectorXd hamiltonian_batch(const Batch& x) const override;
-  void vector_field(const Batch& x, Batch& dxdt) const override;
+  Eigen::VectorXd hamiltonian_batch(const BatchView& x) const override;
+  void vector_field(const BatchView& x, Batch& dxdt) const override;
   /// The two parts of the field: (dH/dp, -dH/dq) and dD/dx.
-  Batch conservative_part(const Batch& x) const;
-  Batch dissipative_part(const Batch& x) const;
+  Batch conservative_part(const BatchView& x) const;
+  Batch dissipative_part(const BatchView& x) const;
   /// Uniform in [-1.2, 1.2]^2 (the paper's grid range).
   Batch sample_initial_states(int n, std::mt19937_64& rng) const override;
 

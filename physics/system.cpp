@@ -52,7 +52,7 @@ SplitField split_field(const VectorField& f) {
           [half](double t, const Batch& x, Batch& dp) { half(t, x, dp, false); }};
 }
 
-void SeparableSystem::vector_field(const Batch& x, Batch& dxdt) const {
+void SeparableSystem::vector_field(const BatchView& x, Batch& dxdt) const {
   const Eigen::Index n = x.cols() / 2;
   dxdt.resize(x.rows(), x.cols());
   velocity(x.rightCols(n), dxdt.leftCols(n));

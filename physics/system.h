@@ -29,13 +29,15 @@ class System {
   virtual int dim() const = 0;
   virtual std::string name() const = 0;
 
-  /// H for every row of x.
-  virtual Eigen::VectorXd hamiltonian_batch(const Batch& x) const = 0;
+  /// H for every row of x. x is a view (BatchView): a Batch, a block of one, or rows of memory
+  /// laid out like one, such as a NumPy array's buffer (apps/python/arrays.h), read in place.
+  virtual Eigen::VectorXd hamiltonian_batch(const BatchView& x) const = 0;
   /// H at one state.
   double hamiltonian(const Eigen::Ref<const Eigen::RowVectorXd>& x) const;
 
-  /// The exact field dx/dt = (dH/dp, -dH/dq), row by row. Resizes dxdt if needed.
-  virtual void vector_field(const Batch& x, Batch& dxdt) const = 0;
+  /// The exact field dx/dt = (dH/dp, -dH/dq), row by row; x a view as above. Resizes dxdt if
+  /// needed.
+  virtual void vector_field(const BatchView& x, Batch& dxdt) const = 0;
 
   /// The energy used in metrics: H itself for the conservative systems here.
   virtual Eigen::VectorXd energy_batch(const Batch& x) const { return hamiltonian_batch(x); }
@@ -74,7 +76,7 @@ class SeparableSystem : public System {
   virtual void force(const BatchView& q, BatchSpan dp) const = 0;
 
   /// Assembled from velocity() and force().
-  void vector_field(const Batch& x, Batch& dxdt) const override;
+  void vector_field(const BatchView& x, Batch& dxdt) const override;
 
   /// Exact halves for splitting integrators (each half costs only its own work).
   /// Refers to *this, like field().

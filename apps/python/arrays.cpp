@@ -59,11 +59,9 @@ bool copy_strided(const py::array& a, Matrix<T>& out) {
   return true;
 }
 
-}  // namespace
-
-template <typename T>
-Matrix<T> states(const py::handle& obj, std::string_view what, Eigen::Index cols) {
-  const py::array a = numeric(obj, what);
+// `obj` as a numeric 2-D array of `cols` columns and at least one row, not yet converted.
+py::array state_array(const py::handle& obj, std::string_view what, Eigen::Index cols) {
+  py::array a = numeric(obj, what);
   if (a.ndim() != 2) {
     throw InputError(fmt::format("{}: expected a 2-D array [batch, {}], got shape {}", what, cols,
                                  shape_text(a)));
@@ -73,8 +71,27 @@ Matrix<T> states(const py::handle& obj, std::string_view what, Eigen::Index cols
         fmt::format("{}: expected {} columns (q then p), got shape {}", what, cols, shape_text(a)));
   }
   if (a.shape(0) == 0) throw InputError(fmt::format("{}: the array is empty (no rows)", what));
-  // Copied once into the row-major matrix the library's functions take (docs/python.md: why
-  // not a view), converted on the way from the common dtypes in any layout.
+  return a;
+}
+
+// Whether `a` can be read in place as a Matrix<T>: of T exactly (native byte order), aligned,
+// C-contiguous (each row's values side by side, row after row: Matrix<T> is row-major).
+template <typename T>
+bool readable_in_place(const py::array& a) {
+  return py::isinstance<py::array_t<T>>(a) && (a.flags() & py::array::c_style) != 0 &&
+         (a.flags() & py::detail::npy_api::NPY_ARRAY_ALIGNED_) != 0;
+}
+
+}  // namespace
+
+std::atomic<long> state_copies{0};
+
+template <typename T>
+Matrix<T> states(const py::handle& obj, std::string_view what, Eigen::Index cols) {
+  const py::array a = state_array(obj, what, cols);
+  // Copied once into the row-major matrix the library's functions take, converted on the way
+  // from the common dtypes in any layout.
+  ++state_copies;
   Matrix<T> out;
   if (!(copy_strided<double>(a, out) || copy_strided<float>(a, out) ||
         copy_strided<std::int64_t>(a, out) || copy_strided<std::int32_t>(a, out))) {
@@ -83,6 +100,26 @@ Matrix<T> states(const py::handle& obj, std::string_view what, Eigen::Index cols
   }
   check_finite(out.data(), out.rows(), cols, what);
   return out;
+}
+
+template <typename T>
+StatesIn<T>::StatesIn(const py::handle& obj, std::string_view what, Eigen::Index cols)
+    : cols_(cols) {
+  py::array a = state_array(obj, what, cols);
+  rows_ = a.shape(0);
+  if (readable_in_place<T>(a)) {
+    check_finite(static_cast<const T*>(a.data()), rows_, cols, what);
+    data_ = static_cast<const T*>(a.data());
+    array_ = std::move(a);
+  } else {
+    copy_ = states<T>(a, what, cols);
+  }
+}
+
+template <typename T>
+ad::MatrixView<T> StatesIn<T>::view() const {
+  if (data_ == nullptr) return copy_;
+  return Eigen::Map<const Matrix<T>>(data_, rows_, cols_);
 }
 
 std::vector<physics::Batch> trajectories(const py::handle& obj, std::string_view what,
@@ -148,6 +185,8 @@ py::array to_array(const physics::Trajectory& path) {
   return out;
 }
 
+template class StatesIn<float>;
+template class StatesIn<double>;
 template Matrix<float> states(const py::handle&, std::string_view, Eigen::Index);
 template Matrix<double> states(const py::handle&, std::string_view, Eigen::Index);
 template py::array to_array(const Matrix<float>&);

@@ -1,6 +1,7 @@
-// hnn.autodiff: derivatives of the library's own functions at a batch of states, by the engine
-// (autodiff/functional.h row_jacobian, to any order): a model's learned scalar (an HNN's H, an
-// LNN's L) and its field's Jacobian; a system's dH/dx from its exact field.
+// hnn.autodiff: derivatives of the library's own functions at a batch of states, to any order: a
+// model's learned scalar (an HNN's H, an LNN's L) and its field's Jacobian by the engine
+// (autodiff/functional.h row_jacobian); a system's H by physics/autodiff/hamiltonian_derivatives.h
+// (the engine on the systems' H written with its ops, GiNaC on an expression's).
 
 #include <fmt/format.h>
 
@@ -10,7 +11,7 @@
 #include "autodiff/tape.h"
 #include "nn/hnn.h"
 #include "nn/lnn.h"
-#include "physics/system.h"
+#include "physics/autodiff/hamiltonian_derivatives.h"
 
 namespace hnn::python {
 
@@ -36,6 +37,11 @@ Matrix<T> row_derivatives(ad::Var<T> y, const ad::Var<T>& x, int order) {
   return y.value();
 }
 
+void check_order(int order) {
+  if (order < 0 || order > kMaxOrder)
+    throw InputError(fmt::format("autodiff: order must be 0 to {}, got {}", kMaxOrder, order));
+}
+
 std::vector<py::ssize_t> shape(Eigen::Index rows, std::initializer_list<Eigen::Index> outputs,
                                Eigen::Index dim, int order) {
   std::vector<py::ssize_t> s{rows};
@@ -47,15 +53,14 @@ std::vector<py::ssize_t> shape(Eigen::Index rows, std::initializer_list<Eigen::I
 }  // namespace
 
 py::array Model::derivative(const py::handle& x, int order) const {
-  if (order < 0 || order > kMaxOrder)
-    throw InputError(fmt::format("autodiff: order must be 0 to {}, got {}", kMaxOrder, order));
+  check_order(order);
   return visit([&]<typename T>(const nn::DynamicsModel<T>& m) {
-    const Matrix<T> states = python::states<T>(x, "x", m.dim());
+    const StatesIn<T> states(x, "x", m.dim());
     Matrix<T> d;
     {
       py::gil_scoped_release free;
       ad::TapeScope scope;
-      const ad::Var<T> xv = ad::Var<T>::variable(states);
+      const ad::Var<T> xv = ad::Var<T>::variable(states.view());
       d = row_derivatives(learned_scalar(m, xv), xv, order);
     }
     return to_array(d, shape(states.rows(), {}, m.dim(), order));
@@ -64,12 +69,12 @@ py::array Model::derivative(const py::handle& x, int order) const {
 
 py::array Model::field_jacobian(const py::handle& x) const {
   return visit([&]<typename T>(const nn::DynamicsModel<T>& m) {
-    const Matrix<T> states = python::states<T>(x, "x", m.dim());
+    const StatesIn<T> states(x, "x", m.dim());
     Matrix<T> j;
     {
       py::gil_scoped_release free;
       ad::TapeScope scope;
-      const ad::Var<T> xv = ad::Var<T>::variable(states);
+      const ad::Var<T> xv = ad::Var<T>::variable(states.view());
       j = row_derivatives(m.time_derivative(xv), xv, 1);
     }
     return to_array(j, shape(states.rows(), {m.dim()}, m.dim(), 1));
@@ -77,16 +82,15 @@ py::array Model::field_jacobian(const py::handle& x) const {
 }
 
 void bind_autodiff(py::module_& m) {
-  m.def("_system_gradient", [](const physics::System& s, const py::handle& x) {
-    // dH/dx from the exact field (dq/dt, dp/dt) = (dH/dp, -dH/dq).
-    const physics::Batch states = python::states<double>(x, "x", s.dim());
-    physics::Batch f;
-    s.vector_field(states, f);
-    const Eigen::Index n = s.dim() / 2;
-    Matrix<double> g(states.rows(), s.dim());
-    g.leftCols(n) = -f.rightCols(n);
-    g.rightCols(n) = f.leftCols(n);
-    return to_array(g);
+  m.def("_system_derivative", [](const physics::System& s, const py::handle& x, int order) {
+    check_order(order);
+    const StatesIn<double> states(x, "x", s.dim());
+    physics::Batch d;
+    {
+      py::gil_scoped_release free;
+      d = physics::hamiltonian_derivatives(s, states.view(), order);
+    }
+    return to_array(d, shape(states.rows(), {}, s.dim(), order));
   });
 }
 

@@ -100,11 +100,11 @@ std::string Model::describe() const {
 
 py::array Model::vector_field(const py::handle& x) const {
   return visit([&]<typename T>(const nn::DynamicsModel<T>& m) {
-    const Matrix<T> states = python::states<T>(x, "x", m.dim());
+    const StatesIn<T> states(x, "x", m.dim());
     Matrix<T> f;
     {
       py::gil_scoped_release free;
-      f = m.field(states);
+      f = m.field(states.view());
     }
     return to_array(f);
   });
@@ -112,13 +112,13 @@ py::array Model::vector_field(const py::handle& x) const {
 
 py::array Model::hamiltonian(const py::handle& x) const {
   return visit([&]<typename T>(const nn::DynamicsModel<T>& m) {
-    const Matrix<T> states = python::states<T>(x, "x", m.dim());
+    const StatesIn<T> states(x, "x", m.dim());
     Matrix<T> h;
     if (const auto* hnn = dynamic_cast<const nn::Hnn<T>*>(&m);
         hnn != nullptr && m.config().field != nn::FieldType::kConservative) {
-      h = hnn->energy(states);
+      h = hnn->energy(states.view());
     } else if (const auto* lnn = dynamic_cast<const nn::Lnn<T>*>(&m)) {
-      h = lnn->energy(states);  // the energy an LNN conserves, v · dL/dv - L
+      h = lnn->energy(states.view());  // the energy an LNN conserves, v · dL/dv - L
     } else {
       throw InputError(fmt::format("hamiltonian: a {} model learns no H", m.name()));
     }

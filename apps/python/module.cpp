@@ -44,6 +44,9 @@ PYBIND11_MODULE(_hnn, m) {
   m.def("set_threads", &hnn::ad::set_num_threads, py::arg("n"),
         "Threads of the engine's fused kernels (the hnn program's --threads)");
   m.def("threads", &hnn::ad::num_threads);
+  m.def(
+      "_state_copies", [] { return hnn::python::state_copies.load(); },
+      "How many state arrays were copied (converted) so far; for tests");
   hnn::python::bind_model(m);
   hnn::python::bind_systems(m);
   hnn::python::bind_runs(m);

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -14,8 +15,8 @@
 #include "apps/python/arrays.h"
 #include "apps/python/interrupt.h"
 #include "autodiff/parallel.h"
-#include "tasks/run.h"
 #include "tasks/options/train_options.h"
+#include "tasks/run.h"
 
 namespace hnn::python {
 
@@ -28,7 +29,7 @@ using tasks::ValueKind;
 // Options `hnn train` has that a call from Python does not take, and why.
 std::string refused(const TrainOption& option) {
   if (option.lands == tasks::Lands::kPrintJson) return "the run object's .metrics holds them";
-  if (option.lands == tasks::Lands::kResume) return "resume a run with hnn train --resume DIR";
+  if (option.lands == tasks::Lands::kResume) return "hnn.train takes it as its argument resume";
   return "";
 }
 
@@ -61,10 +62,34 @@ json canonical(const TrainOption& option, const json& value) {
   }
 }
 
-// The options of `hnn train TASK --name value...`.
-tasks::RunOptions run_options(const std::string& task, const json& given) {
-  std::vector<std::pair<const TrainOption*, json>> asked;
-  asked.emplace_back(tasks::find_train_option("task"), task);
+using Asked = std::vector<std::pair<const TrainOption*, json>>;
+
+// The options `hnn train --resume DIR` starts from (apps/hnn/commands/train.cpp): the run's own,
+// from its checkpoint, continued to the steps asked if any (the table's continues_resume);
+// refuses an option asked that could change the result (not the table's with_resume).
+tasks::RunOptions resumed(const std::string& run_dir, const Asked& asked) {
+  std::optional<int> steps;  // more steps: a finished run continued
+  for (const auto& [option, value] : asked) {
+    if (option->continues_resume) {
+      steps = canonical(*option, value).get<int>();
+    } else if (!option->with_resume) {
+      std::string name(option->name);
+      std::replace(name.begin(), name.end(), '-', '_');
+      throw InputError(fmt::format(
+          "{} cannot be combined with resume: a resumed run keeps its own settings", name));
+    }
+  }
+  return tasks::resume_options(run_dir, steps);
+}
+
+// The options of `hnn train TASK --name value...`, or with `resume` a folder, of `hnn train
+// --resume RESUME --name value...`: resumed()'s, with the options asked on top.
+tasks::RunOptions run_options(const std::string& task, const json& given,
+                              const std::string& resume) {
+  Asked asked;
+  if (resume.empty()) asked.emplace_back(tasks::find_train_option("task"), task);
+  if (!resume.empty() && !task.empty())
+    throw InputError("task cannot be combined with resume: a resumed run keeps its own settings");
   for (const auto& [key, value] : given.items()) {
     std::string name = key;
     std::replace(name.begin(), name.end(), '_', '-');
@@ -80,9 +105,9 @@ tasks::RunOptions run_options(const std::string& task, const json& given) {
   std::sort(asked.begin(), asked.end(), [](const auto& a, const auto& b) {
     return std::less<const TrainOption*>()(a.first, b.first);
   });
-  tasks::RunOptions o;
+  tasks::RunOptions o = resume.empty() ? tasks::RunOptions{} : resumed(resume, asked);
   for (const auto& [option, value] : asked) {
-    if (const std::string why = tasks::not_applicable(*option, task); !why.empty())
+    if (const std::string why = tasks::not_applicable(*option, o.task); !why.empty())
       throw InputError(fmt::format("{} {}", option->name, why));
     tasks::apply(*option, canonical(*option, value), o);
   }
@@ -103,9 +128,10 @@ class KeepThreads {
 };
 
 // Trains and writes the run folder; returns its path. Ctrl-C stops after the step, with a
-// checkpoint, and raises KeyboardInterrupt (resume with hnn train --resume).
-std::string train(const std::string& task, const std::string& options_json) {
-  tasks::RunOptions o = run_options(task, json::parse(options_json));
+// checkpoint, and raises KeyboardInterrupt (resume with resume=OUT, or hnn train --resume OUT).
+std::string train(const std::string& task, const std::string& options_json,
+                  const std::string& resume) {
+  tasks::RunOptions o = run_options(task, json::parse(options_json), resume);
   Interrupt interrupt;
   o.stop = interrupt.signal();
   const KeepThreads keep;
@@ -121,7 +147,7 @@ std::string train(const std::string& task, const std::string& options_json) {
 }  // namespace
 
 void bind_runs(py::module_& m) {
-  m.def("_train", &train, py::arg("task"), py::arg("options_json"));
+  m.def("_train", &train, py::arg("task"), py::arg("options_json"), py::arg("resume") = "");
 }
 
 }  // namespace hnn::python

@@ -23,12 +23,14 @@ using physics::System;
 using SystemPtr = std::shared_ptr<System>;
 
 py::array system_hamiltonian(const System& s, const py::handle& x) {
-  return to_array(s.hamiltonian_batch(states<double>(x, "x", s.dim())));
+  const StatesIn<double> states(x, "x", s.dim());
+  return to_array(s.hamiltonian_batch(states.view()));
 }
 
 py::array system_field(const System& s, const py::handle& x) {
   physics::Batch dxdt;
-  s.vector_field(states<double>(x, "x", s.dim()), dxdt);
+  const StatesIn<double> states(x, "x", s.dim());
+  s.vector_field(states.view(), dxdt);
   return to_array(dxdt);
 }
 

@@ -72,7 +72,7 @@ AutodiffSystem::AutodiffSystem(std::string name, int n_dof, AutodiffHamiltonian 
   sampler_ = std::move(sampler);
 }
 
-void AutodiffSystem::check_columns(const Batch& x) const {
+void AutodiffSystem::check_columns(const BatchView& x) const {
   if (x.cols() != dim()) {
     throw std::invalid_argument(
         fmt::format("{}: a batch of {} columns; states have {} (q_1..q_{}, "
@@ -104,7 +104,7 @@ ad::Var<double> AutodiffSystem::evaluate(const ad::Var<double>& q, const ad::Var
   return h;
 }
 
-void AutodiffSystem::check_finite(const Batch& x, const Batch& out, const char* what) const {
+void AutodiffSystem::check_finite(const BatchView& x, const Batch& out, const char* what) const {
   if (out.allFinite()) return;
   Eigen::Index row = 0, k = 0;
   while (std::isfinite(out(row, k))) {
@@ -118,7 +118,7 @@ void AutodiffSystem::check_finite(const Batch& x, const Batch& out, const char* 
                                           value_text(out(row, k)), row, fmt::join(state, ", ")));
 }
 
-Eigen::VectorXd AutodiffSystem::hamiltonian_batch(const Batch& x) const {
+Eigen::VectorXd AutodiffSystem::hamiltonian_batch(const BatchView& x) const {
   check_columns(x);
   if (x.rows() == 0) return Eigen::VectorXd(0);
   ad::TapeScope scope;
@@ -129,7 +129,7 @@ Eigen::VectorXd AutodiffSystem::hamiltonian_batch(const Batch& x) const {
   return h.value().col(0);
 }
 
-Batch AutodiffSystem::gradient(const Batch& x) const {
+Batch AutodiffSystem::gradient(const BatchView& x) const {
   check_columns(x);
   Batch dh(x.rows(), dim());
   if (x.rows() == 0) return dh;
@@ -149,7 +149,7 @@ Batch AutodiffSystem::gradient(const Batch& x) const {
   return dh;
 }
 
-void AutodiffSystem::vector_field(const Batch& x, Batch& dxdt) const {
+void AutodiffSystem::vector_field(const BatchView& x, Batch& dxdt) const {
   const Batch dh = gradient(x);
   dxdt.resize(x.rows(), dim());
   dxdt.leftCols(n_dof_) = dh.rightCols(n_dof_);

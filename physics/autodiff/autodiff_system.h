@@ -65,22 +65,24 @@ class AutodiffSystem : public System {
   /// Degrees of freedom n (dim() / 2).
   int n_dof() const { return n_dof_; }
   std::string name() const override { return name_; }
-  Eigen::VectorXd hamiltonian_batch(const Batch& x) const override;
+  Eigen::VectorXd hamiltonian_batch(const BatchView& x) const override;
   /// (dH/dp, -dH/dq) row by row. Resizes dxdt if needed.
-  void vector_field(const Batch& x, Batch& dxdt) const override;
+  void vector_field(const BatchView& x, Batch& dxdt) const override;
   /// From the StateSampler, or as BoxSampling says; deterministic in rng. Throws
   /// std::invalid_argument when the energy band stays unfilled after max_draws.
   Batch sample_initial_states(int n, std::mt19937_64& rng) const override;
 
+  /// H as given to the constructor.
+  const AutodiffHamiltonian& hamiltonian_function() const { return hamiltonian_; }
   /// dH/dx = (dH/dq, dH/dp) for every row (R x dim), exact by reverse mode.
-  Batch gradient(const Batch& x) const;
+  Batch gradient(const BatchView& x) const;
 
  private:
-  void check_columns(const Batch& x) const;
+  void check_columns(const BatchView& x) const;
   // H on the tape for q = x's first n columns and p = its last n; checks the shape.
   ad::Var<double> evaluate(const ad::Var<double>& q, const ad::Var<double>& p) const;
   // Throws naming the first state where `out` (H or the field, called `what`) is not finite.
-  void check_finite(const Batch& x, const Batch& out, const char* what) const;
+  void check_finite(const BatchView& x, const Batch& out, const char* what) const;
   Batch sample_box(int n, std::mt19937_64& rng) const;
 
   std::string name_;

@@ -42,6 +42,31 @@ class Arrays(unittest.TestCase):
                   lambda x: hnn.HNN(2, hidden=(8,), seed=3).fit(x, x, steps=3)):
             self.assert_same_as_copy(f)
 
+    def test_c_contiguous_arrays_of_the_dtype_are_read_in_place(self):
+        # The package counts the state arrays it copies (arrays.cpp, states()): a C-contiguous
+        # array of the computation's dtype is read in place, any other converted once, with the
+        # same results to the bit.
+        model, spring = hnn.HNN(2, hidden=(8,), seed=0), hnn.systems.Spring()
+        x = np.random.default_rng(1).standard_normal((64, 2))
+        float32 = hnn.HNN(2, hidden=(8,), dtype="float32", seed=0)
+        for name, f, v in [("field", model.vector_field, x), ("H", model.hamiltonian, x),
+                           ("grad", lambda a: hnn.autodiff.grad(model, a), x),
+                           ("jacobian", lambda a: hnn.autodiff.jacobian(model, a), x),
+                           ("system field", spring.vector_field, x),
+                           ("system H", spring.hamiltonian, x),
+                           ("system hessian", lambda a: hnn.autodiff.hessian(spring, a), x),
+                           ("float32 field", float32.vector_field, x.astype(np.float32))]:
+            with self.subTest(call=name):
+                before = hnn._hnn._state_copies()
+                in_place = f(v)
+                self.assertEqual(hnn._hnn._state_copies(), before)
+                copied = f(np.asfortranarray(v))
+                self.assertEqual(hnn._hnn._state_copies(), before + 1)
+                np.testing.assert_array_equal(in_place, copied)
+        before = hnn._hnn._state_copies()
+        float32.vector_field(x)  # float64 into a float32 model: converted
+        self.assertEqual(hnn._hnn._state_copies(), before + 1)
+
     def test_states_are_copied_once(self):
         # NumPy's allocations are traced, the engine's are not: a Fortran-order or sliced
         # float64 array, and an int64 one, must not be converted by NumPy before the copy

@@ -194,8 +194,6 @@ class Autodiff(unittest.TestCase):
             hnn.autodiff.grad(hnn.Baseline(4, hidden=(4,)), self.x)
         with self.assertRaisesRegex(hnn.Error, "order must be 0 to 6, got 7"):
             hnn.autodiff.derivative(hnn.HNN(4, hidden=(4,)), self.x, 7)
-        with self.assertRaisesRegex(hnn.Error, "order 1 only"):
-            hnn.autodiff.hessian(hnn.systems.Spring(), self.x[:, :2])
 
 
 class Types(unittest.TestCase):

@@ -86,6 +86,32 @@ class Programs(unittest.TestCase):
         with self.assertRaisesRegex(hnn.Error, "resume"):  # the program's own guard
             hnn.train("spring", out=out, steps=10, quiet=True)
 
+    def test_resume_continues_a_run_as_the_program_does(self):
+        base = ["--hidden", "8", "--lr", "0.01", "--quiet"]
+        run_hnn("train", "spring", "--out", "cli-more", "--steps", "10", *base, cwd=self.dir)
+        run_hnn("train", "--resume", "cli-more", "--steps", "20", "--quiet", cwd=self.dir)
+        out = os.path.join(self.dir, "py-more")
+        hnn.train("spring", out=out, steps=10, hidden=[8], lr=0.01, quiet=True)
+        run = hnn.train(out=out, resume=True, steps=20, quiet=True)
+        cli = hnn.load_run(os.path.join(self.dir, "cli-more"))
+
+        def untimed(metrics):
+            return {k: v for k, v in metrics.items() if not k.endswith("seconds")}
+        self.assertEqual(run.metrics["continued_from"], [10])
+        self.assertEqual(untimed(run.metrics), untimed(cli.metrics))
+        np.testing.assert_array_equal(run.loss_curve["train_loss"],
+                                      cli.loss_curve["train_loss"])
+        again = hnn.train(resume=out, steps=30, quiet=True, threads=1)  # resume=DIR
+        self.assertEqual(again.metrics["continued_from"], [10, 20])
+        for pattern, call in [
+                ("lr cannot be combined with resume", lambda: hnn.train(resume=out, lr=0.1)),
+                ("task cannot be combined with resume", lambda: hnn.train("spring", resume=out)),
+                ("resume=True continues the run in out", lambda: hnn.train(resume=True)),
+                ("fewer than the 30 steps", lambda: hnn.train(resume=out, steps=25))]:
+            with self.subTest(pattern=pattern):
+                with self.assertRaisesRegex(hnn.Error, pattern):
+                    call()
+
     def test_a_model_saved_from_python_runs_in_the_program(self):
         # The run's own model, its weights changed from Python and saved into a copy of the run:
         # the program's rollout of it is the package's.

@@ -32,7 +32,7 @@ class FunctionModel : public nn::DynamicsModel<double> {
   ad::Var<double> time_derivative(const ad::Var<double>&) const override {
     throw std::logic_error("FunctionModel gives values only");
   }
-  nn::Matrix<double> field(const nn::Matrix<double>& x) const override { return fn_(x); }
+  nn::Matrix<double> field(const nn::MatrixView<double>& x) const override { return fn_(x); }
 
  private:
   static nn::DynamicsConfig config(Eigen::Index dim) {

@@ -27,7 +27,7 @@ class KnownField : public nn::DynamicsModel<double> {
   using Fn = std::function<Var(const Var&)>;
   explicit KnownField(Fn f) : DynamicsModel(config(), mlp()), f_(std::move(f)) {}
   Var time_derivative(const Var& x) const override { return f_(x); }
-  Matrix field(const Matrix& x) const override {
+  Matrix field(const ad::MatrixView<double>& x) const override {
     ad::TapeScope scope;
     ad::NoGradGuard values;
     return f_(Var::constant(x)).value();

@@ -16,15 +16,33 @@ from . import _hnn
 __all__ = ["Run", "train", "load_run"]
 
 
-def train(task, model="hnn", seed=0, out=None, **options):
+def train(task=None, model=None, seed=None, out=None, resume=False, **options):
     """Runs `hnn train TASK --model MODEL --seed SEED --out OUT --OPTION VALUE...` and returns
     the Run. Options are `hnn train`'s (its table: docs/inputs.md), with '_' for '-'
-    (lr_schedule="cosine"), e.g. steps=200, hidden=[32, 32], dtype="float", settings={...}.
-    Without `out`, the folder is hnn train's default, runs/TASK/MODEL. Ctrl-C stops after the
-    current step with a checkpoint (resume with hnn train --resume OUT) and raises
-    KeyboardInterrupt."""
+    (lr_schedule="cosine"), e.g. steps=200, hidden=[32, 32], dtype="float", settings={...};
+    model and seed default to "hnn" and 0. Without `out`, the folder is hnn train's default,
+    runs/TASK/MODEL. Ctrl-C stops after the current step with a checkpoint and raises
+    KeyboardInterrupt.
+
+    resume=True continues the run in `out`, resume=DIR the run in DIR, as `hnn train --resume
+    DIR` does: an interrupted run to its end from its last checkpoint, a finished one to a
+    larger `steps`. The run keeps its own settings: no task, and only the options that cannot
+    change its result (threads, quiet, checkpoint_every, ...)."""
+    folder = ""
+    if resume is True:
+        if out is None:
+            raise _hnn.Error("train: resume=True continues the run in out: give out, or "
+                             "resume=DIR")
+        folder, out = os.fspath(out), None
+    elif resume is not False and resume is not None:
+        folder = os.fspath(resume)
+    if not folder:
+        if task is None:
+            raise _hnn.Error("train needs a task (or resume=True with out, or resume=DIR)")
+        model = "hnn" if model is None else model
+        seed = 0 if seed is None else seed
     options.update(model=model, seed=seed, out=None if out is None else os.fspath(out))
-    return Run(_hnn._train(task, json.dumps(options)))
+    return Run(_hnn._train(task or "", json.dumps(options), folder))
 
 
 def load_run(path):

@@ -9,8 +9,9 @@ from ._hnn import Model
 
 __all__: list[str]
 
-def train(task: str, model: str = "hnn", seed: int = 0,
-          out: Optional[str | PathLike[str]] = None, **options: Any) -> Run: ...
+def train(task: Optional[str] = None, model: Optional[str] = None, seed: Optional[int] = None,
+          out: Optional[str | PathLike[str]] = None,
+          resume: bool | str | PathLike[str] = False, **options: Any) -> Run: ...
 def load_run(path: str | PathLike[str]) -> Run: ...
 
 class Run:
