@@ -80,7 +80,7 @@ Eigen::MatrixXd ChainPendulumAngles::mass_matrix(const Eigen::VectorXd& theta) c
   return m;
 }
 
-Eigen::VectorXd ChainPendulumAngles::hamiltonian_batch(const Batch& x) const {
+Eigen::VectorXd ChainPendulumAngles::hamiltonian_batch(const BatchView& x) const {
   const int n = links();
   Eigen::VectorXd h(x.rows());
   for (Eigen::Index r = 0; r < x.rows(); ++r) {
@@ -123,7 +123,7 @@ Eigen::VectorXd ChainPendulumAngles::angular_acceleration(const Eigen::VectorXd&
   return mass_matrix(theta).ldlt().solve(momentum_rate(theta, omega) - m_dot * omega);
 }
 
-void ChainPendulumAngles::vector_field(const Batch& x, Batch& dxdt) const {
+void ChainPendulumAngles::vector_field(const BatchView& x, Batch& dxdt) const {
   const int n = links();
   dxdt.resize(x.rows(), 2 * n);
   for (Eigen::Index r = 0; r < x.rows(); ++r) {
@@ -137,11 +137,11 @@ void ChainPendulumAngles::vector_field(const Batch& x, Batch& dxdt) const {
 ChainPendulumVelocities::ChainPendulumVelocities(ChainPendulumAngles canonical)
     : canonical_(std::move(canonical)) {}
 
-Eigen::VectorXd ChainPendulumVelocities::hamiltonian_batch(const Batch& x) const {
+Eigen::VectorXd ChainPendulumVelocities::hamiltonian_batch(const BatchView& x) const {
   return canonical_.hamiltonian_batch(canonical_.momenta_from_velocities(x));
 }
 
-void ChainPendulumVelocities::vector_field(const Batch& x, Batch& dxdt) const {
+void ChainPendulumVelocities::vector_field(const BatchView& x, Batch& dxdt) const {
   const int n = canonical_.links();
   dxdt.resize(x.rows(), 2 * n);
   for (Eigen::Index r = 0; r < x.rows(); ++r) {

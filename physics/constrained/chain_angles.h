@@ -32,8 +32,8 @@ class ChainPendulumAngles : public System {
   int dim() const override { return 2 * links(); }
   std::string name() const override { return cartesian_.name() + "_angles"; }
   int links() const { return static_cast<int>(masses_.size()); }
-  Eigen::VectorXd hamiltonian_batch(const Batch& x) const override;
-  void vector_field(const Batch& x, Batch& dxdt) const override;
+  Eigen::VectorXd hamiltonian_batch(const BatchView& x) const override;
+  void vector_field(const BatchView& x, Batch& dxdt) const override;
   /// The Cartesian chain's sampler mapped to (theta, p): the same distribution of states.
   Batch sample_initial_states(int n, std::mt19937_64& rng) const override;
 
@@ -71,8 +71,8 @@ class ChainPendulumVelocities : public System {
 
   int dim() const override { return canonical_.dim(); }
   std::string name() const override { return canonical_.cartesian().name() + "_velocities"; }
-  Eigen::VectorXd hamiltonian_batch(const Batch& x) const override;
-  void vector_field(const Batch& x, Batch& dxdt) const override;
+  Eigen::VectorXd hamiltonian_batch(const BatchView& x) const override;
+  void vector_field(const BatchView& x, Batch& dxdt) const override;
   /// The Cartesian chain's sampler mapped to (theta, omega).
   Batch sample_initial_states(int n, std::mt19937_64& rng) const override;
   /// (theta, omega) rows -> Cartesian (x, v) rows.

@@ -73,7 +73,7 @@ Eigen::VectorXd ConstrainedSystem::potential_gradient(const double* x) const {
   return grad;
 }
 
-Eigen::VectorXd ConstrainedSystem::hamiltonian_batch(const Batch& z) const {
+Eigen::VectorXd ConstrainedSystem::hamiltonian_batch(const BatchView& z) const {
   const int n = configuration_dim();
   Eigen::VectorXd energy(z.rows());
   for (Eigen::Index r = 0; r < z.rows(); ++r) {
@@ -185,13 +185,14 @@ Batch ConstrainedSystem::acceleration(const Batch& z) const {
 // (v, acceleration()); off it, phi and J v stay constant along the exact flow, so the drift
 // of a numerical solution is the integrator's error alone (the multiplier form would let a
 // velocity error grow phi linearly in time).
-void ConstrainedSystem::vector_field(const Batch& z, Batch& dzdt) const {
+void ConstrainedSystem::vector_field(const BatchView& z, Batch& dzdt) const {
   const int n = configuration_dim();
   dzdt.resize(z.rows(), 2 * n);
   for (Eigen::Index r = 0; r < z.rows(); ++r) {
-    const Linearization lin = linearize(&z(r, 0), &z(r, n));
+    const double* positions = z.row(r).data();  // then the velocities (rows are contiguous)
+    const Linearization lin = linearize(positions, positions + n);
     const Eigen::VectorXd v = z.row(r).segment(n, n).transpose();
-    const Eigen::VectorXd free = -inverse_mass_full_ * potential_gradient(&z(r, 0));
+    const Eigen::VectorXd free = -inverse_mass_full_ * potential_gradient(positions);
     // The system for mu = (mu1, mu2) is [[0, A], [-A, B]] mu = -(J v, H v + J M^-1 f) with
     // A = J M^-1 J^T and B = H M^-1 J^T - J M^-1 H^T: two solves with A's factors.
     const Eigen::MatrixXd minv_jt = inverse_mass_full_ * lin.jacobian.transpose();

@@ -80,14 +80,14 @@ class ConstrainedSystem : public System {
   /// The peer's output times: 0, dt, 2 dt, ... below horizon (100 of them for its systems).
   std::vector<double> output_times() const;
 
-  Eigen::VectorXd hamiltonian_batch(const Batch& z) const override;
+  Eigen::VectorXd hamiltonian_batch(const BatchView& z) const override;
   double potential(const double* x) const;
   Eigen::VectorXd potential_gradient(const double* x) const;
 
   /// The ground-truth field: the exact constrained dynamics written in the projected form of
   /// the peer's ConstrainedHamiltonianDynamics (see constrained_system.cpp), which equals
   /// (v, acceleration) on the manifold and keeps phi and d phi/dt constant off it.
-  void vector_field(const Batch& z, Batch& dzdt) const override;
+  void vector_field(const BatchView& z, Batch& dzdt) const override;
   /// M a = -grad V - J^T lambda with lambda from (J M^-1 J^T) lambda = J M^-1 f + H v, the
   /// solve that keeps d^2 phi / dt^2 = 0. Rows x Nd.
   Batch acceleration(const Batch& z) const;
