@@ -1,0 +1,51 @@
+#pragma once
+// The description of a constrained mechanical system in Cartesian coordinates, as the CHNN and
+// CLNN models (nn/constrained/constrained_model.h) take it: N point masses in d dimensions, a
+// constant mass matrix over the points acting on each axis alike, and holonomic distance
+// constraints between two points (rods) or between a point and a fixed point (pivots). nn does not
+// include physics/: tasks/ converts a physics system's description into this one.
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "autodiff/var.h"
+
+namespace hnn::nn {
+
+/// |x_i - x_j| = length.
+struct Link {
+  Eigen::Index i = 0, j = 0;
+  double length = 1;
+};
+
+/// |x_i - point| = length, point fixed in space (d coordinates).
+struct Anchor {
+  Eigen::Index i = 0;
+  std::vector<double> point;
+  double length = 1;
+};
+
+/// A state z = (x, v) of such a system is a row of 2 N d numbers: the positions x, point by point
+/// (point i's axis k at column i d + k), then the velocities v = dx/dt in the same order.
+struct ConstraintSpec {
+  Eigen::Index points = 0;  // N; 0 means no constrained system (the other model kinds)
+  Eigen::Index dim = 0;     // d, the dimension of space
+  /// N x N, symmetric positive definite (non-diagonal for rigid bodies built of points): the
+  /// kinetic energy is 1/2 sum_k v[:, k]^T M v[:, k] over the axes k.
+  Eigen::MatrixXd mass;
+  std::vector<Link> links;
+  std::vector<Anchor> anchors;
+
+  bool empty() const { return points == 0; }
+  /// The number of constraints C: links first, then anchors (the order of the multipliers).
+  Eigen::Index constraints() const { return Eigen::Index(links.size() + anchors.size()); }
+  /// N d, the size of x (and of v).
+  Eigen::Index positions() const { return points * dim; }
+};
+
+/// Throws std::invalid_argument naming the first thing wrong: N or d < 1, a mass matrix that is not
+/// N x N, finite, symmetric and positive definite, a point index out of range, a link from a point
+/// to itself or given twice, an anchor point of the wrong size, a length not finite and > 0.
+void validate(const ConstraintSpec& spec);
+
+}  // namespace hnn::nn
