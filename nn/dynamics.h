@@ -40,11 +40,10 @@ inline bool learns_scalars(ModelKind kind) {
 inline bool is_constrained(ModelKind kind) {
   return kind == ModelKind::kChnn || kind == ModelKind::kClnn;
 }
-/// Whether the state's second half is velocities dq/dt (an LNN's, a CHNN's or a CLNN's), not
-/// canonical momenta.
-inline bool needs_velocities(ModelKind kind) {
-  return kind == ModelKind::kLnn || is_constrained(kind);
-}
+/// Whether the state's second half is velocities dq/dt (an LNN's), not canonical momenta, of the
+/// task's own coordinates. (A CHNN's and a CLNN's are velocities too, but of the Cartesian points
+/// of DynamicsConfig::constraints, which no task in generalised coordinates has.)
+inline bool needs_velocities(ModelKind kind) { return kind == ModelKind::kLnn; }
 
 /// The names: "hnn", "baseline", "dhnn", "lnn", "chnn", "clnn"; "solenoidal", "conservative",
 /// "both".

@@ -113,7 +113,6 @@ TEST(ConstrainedTraining, FactoryBuildsNamesAndCastsBothKinds) {
     ASSERT_NE(dynamic_cast<const nn::ConstrainedModel<double>*>(model.get()), nullptr);
     EXPECT_EQ(nn::parse_model_kind(nn::to_string(kind)), kind);
     EXPECT_EQ(model->kind(), std::string(nn::to_string(kind)) + ":tanh");
-    EXPECT_TRUE(nn::needs_velocities(kind));
     EXPECT_EQ(model->mlp().input_dim(), 4);  // the positions only
     EXPECT_EQ(model->named_parameters().front().name, "mlp.layers.0.weight");
     const auto as_float = nn::cast_model<float>(*model);
