@@ -62,6 +62,10 @@ void check_links(const ConstraintSpec& spec) {
   }
 }
 
+bool finite(const std::vector<double>& values) {
+  return std::all_of(values.begin(), values.end(), [](double c) { return std::isfinite(c); });
+}
+
 void check_anchors(const ConstraintSpec& spec) {
   for (std::size_t k = 0; k < spec.anchors.size(); ++k) {
     const Anchor& anchor = spec.anchors[k];
@@ -71,11 +75,28 @@ void check_anchors(const ConstraintSpec& spec) {
       fail(fmt::format("{} has a fixed point of {} coordinates in {} dimensions", where,
                        anchor.point.size(), spec.dim));
     }
-    if (!std::all_of(anchor.point.begin(), anchor.point.end(),
-                     [](double c) { return std::isfinite(c); })) {
+    if (!finite(anchor.point)) {
       fail(where + " has a non-finite fixed point");
     }
     check_length(anchor.length, where);
+  }
+}
+
+void check_pins(const ConstraintSpec& spec) {
+  for (std::size_t k = 0; k < spec.pins.size(); ++k) {
+    const Pin& pin = spec.pins[k];
+    const std::string where = fmt::format("pin {}", k);
+    if (Eigen::Index(pin.weights.size()) != spec.points || !finite(pin.weights)) {
+      fail(fmt::format("{} needs {} finite weights (one per point), got {}", where, spec.points,
+                       pin.weights.size()));
+    }
+    if (std::all_of(pin.weights.begin(), pin.weights.end(), [](double w) { return w == 0; })) {
+      fail(where + " has only zero weights");
+    }
+    if (Eigen::Index(pin.point.size()) != spec.dim || !finite(pin.point)) {
+      fail(fmt::format("{} needs a fixed point of {} finite coordinates, got {}", where, spec.dim,
+                       pin.point.size()));
+    }
   }
 }
 
@@ -88,6 +109,7 @@ void validate(const ConstraintSpec& spec) {
   check_mass(spec);
   check_links(spec);
   check_anchors(spec);
+  check_pins(spec);
 }
 
 }  // namespace hnn::nn

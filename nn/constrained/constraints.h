@@ -25,6 +25,14 @@ struct Anchor {
   double length = 1;
 };
 
+/// sum_j weights[j] x_j = point: d constraints, one per axis. A point of a rigid body (affine
+/// weights over the system's points) held at a fixed point in space, a ball joint (the gyroscope's
+/// and the rotor's pivots).
+struct Pin {
+  std::vector<double> weights;  // one per point
+  std::vector<double> point;    // d coordinates
+};
+
 /// A state z = (x, v) of such a system is a row of 2 N d numbers: the positions x, point by point
 /// (point i's axis k at column i d + k), then the velocities v = dx/dt in the same order.
 struct ConstraintSpec {
@@ -35,17 +43,24 @@ struct ConstraintSpec {
   Eigen::MatrixXd mass;
   std::vector<Link> links;
   std::vector<Anchor> anchors;
+  std::vector<Pin> pins;
 
   bool empty() const { return points == 0; }
-  /// The number of constraints C: links first, then anchors (the order of the multipliers).
-  Eigen::Index constraints() const { return Eigen::Index(links.size() + anchors.size()); }
+  /// The constraints' blocks, each a d-vector e linear in x: links, anchors, then pins.
+  Eigen::Index blocks() const { return Eigen::Index(links.size() + anchors.size() + pins.size()); }
+  /// The number of scalar constraints C: one per link and per anchor (|e|^2 = l^2), d per pin
+  /// (e = 0), in that order (the order of the multipliers).
+  Eigen::Index constraints() const {
+    return Eigen::Index(links.size() + anchors.size()) + dim * Eigen::Index(pins.size());
+  }
   /// N d, the size of x (and of v).
   Eigen::Index positions() const { return points * dim; }
 };
 
 /// Throws std::invalid_argument naming the first thing wrong: N or d < 1, a mass matrix that is not
 /// N x N, finite, symmetric and positive definite, a point index out of range, a link from a point
-/// to itself or given twice, an anchor point of the wrong size, a length not finite and > 0.
+/// to itself or given twice, an anchor point of the wrong size, a length not finite and > 0, a pin
+/// whose weights are not N finite numbers, not all zero, or whose point is not d finite numbers.
 void validate(const ConstraintSpec& spec);
 
 }  // namespace hnn::nn

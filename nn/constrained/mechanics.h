@@ -5,12 +5,13 @@
 // and the Lagrangian one (CLNN: M a = -dV/dx - DPhi^T lambda with d^2 Phi / dt^2 = 0). Both are
 // written in ad ops on a batch of states, so training differentiates through them to any order.
 //
-// Note [Distance constraints]. Each constraint is phi_c = (|e_c|^2 - l_c^2) / 2 with e_c = x_i -
-// x_j (a link) or x_i - a (an anchor), so e = x D^T - a, D the signed incidence of the
-// constraints on the points times I_d (constant). Then, per state, with E the rows e_c and
-// W = v D^T the rows w_c = de_c/dt:
-//   G = DPhi, (G u)_c = e_c . (D u)_c;     Gdot, (Gdot u)_c = w_c . (D u)_c;
-//   S = G M^-1 G^T, S_cc' = B_cc' e_c . e_c';  B = (incidence) M^-1 (incidence)^T, C x C,
+// Note [Constraint blocks]. Each constraint block is a d-vector linear in x, e_b = x_i - x_j (a
+// link), x_i - a (an anchor) or sum_j w_j x_j - a (a pin), so e = x D^T - a with D the blocks'
+// incidence on the points (+-1, or a pin's weights) times I_d, a constant. A link or an anchor is
+// one constraint phi_c = (|e_c|^2 - l_c^2) / 2, a pin d constraints e_p = 0. Per state, with E the
+// rows e_c and W = v D^T the rows w_c = de_c/dt (a pin's E is 1 and its W 0 in the formulas):
+//   G = DPhi, (G u)_c = e_c . (D u)_c, a pin's rows (D u)_p;  Gdot, (Gdot u)_c = w_c . (D u)_c;
+//   S = G M^-1 G^T, S_cc' = B_cc' e_c . e_c',  B = D M^-1 D^T per block (blocks x blocks),
 // so the Gram blocks are one batched outer product of E times a constant: no Jacobian is formed.
 
 #include "nn/constrained/constraints.h"
@@ -42,17 +43,18 @@ class ConstrainedMechanics {
  private:
   struct Geometry;  // E, W and the Gram blocks of one batch
   Geometry geometry(const ad::Var<T>& z) const;
-  ad::Var<T> group(const ad::Var<T>& y) const;   // R x C d -> R x C: sum over each e_c's axes
-  ad::Var<T> expand(const ad::Var<T>& l) const;  // R x C -> R x C d: l_c on each of e_c's axes
+  ad::Var<T> group(const ad::Var<T>& y) const;   // R x blocks d -> R x C: sums a distance's axes
+  ad::Var<T> expand(const ad::Var<T>& l) const;  // R x C -> R x blocks d: its adjoint
 
   ConstraintSpec spec_;
   Matrix<T> mass_;               // M (x) I_d, N d x N d
   Matrix<T> inverse_;            // M^-1 (x) I_d, N d x N d
-  Matrix<T> incidence_;          // D^T, N d x C d
-  Matrix<T> inverse_incidence_;  // M^-1 D^T, N d x C d
-  Matrix<T> anchors_;            // a, 1 x C d (zero for links)
-  Matrix<T> group_;              // C d x C: 1 where row c d + k meets column c
-  Matrix<T> gram_;               // (C d)^2 x C^2: B_cc' where (c d + k, c' d + k) meets (c, c')
+  Matrix<T> incidence_;          // D^T without the pins' columns, N d x blocks d: E and W
+  Matrix<T> full_incidence_;     // D^T, N d x blocks d
+  Matrix<T> inverse_incidence_;  // M^-1 D^T, N d x blocks d
+  Matrix<T> offsets_;            // 1 x blocks d: an anchor's point, -1 on a pin's axes (E = 1)
+  Matrix<T> group_;  // blocks d x C: 1 where block b's axis k meets its constraint's row
+  Matrix<T> gram_;   // (blocks d)^2 x C^2: see gram_operator in mechanics.cpp
 };
 
 }  // namespace hnn::nn

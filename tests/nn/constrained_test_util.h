@@ -36,8 +36,9 @@ inline DynamicsConfig constrained_config(ModelKind kind, const ConstraintSpec& s
   return config;
 }
 
-/// G = dPhi/dx (C x N d) at positions x for phi_c = |e_c|^2 / 2, links then anchors; with the
-/// velocities in place of the positions in e (relative velocities, anchors still), Gdot.
+/// G = dPhi/dx (C x N d) at positions x for phi_c = |e_c|^2 / 2, links then anchors, then a pin's
+/// d rows (its weights on each axis); with the velocities in place of the positions in e
+/// (relative velocities, anchors still, pins zero), Gdot.
 inline Eigen::MatrixXd constraint_jacobian(const ConstraintSpec& spec, const Eigen::VectorXd& x,
                                            bool velocities = false) {
   const Index d = spec.dim;
@@ -53,7 +54,35 @@ inline Eigen::MatrixXd constraint_jacobian(const ConstraintSpec& spec, const Eig
     if (!velocities) e -= Eigen::Map<const Eigen::VectorXd>(anchor.point.data(), d);
     g.block(c++, anchor.i * d, 1, d) = e.transpose();
   }
+  for (const Pin& pin : spec.pins) {
+    for (Index k = 0; k < d && !velocities; ++k)
+      for (Index j = 0; j < spec.points; ++j) g(c + k, j * d + k) = pin.weights[std::size_t(j)];
+    c += d;
+  }
   return g;
+}
+
+/// M^-1 (x) I_d, the inverse mass on the point-major positions.
+inline Eigen::MatrixXd inverse_mass(const ConstraintSpec& spec) {
+  const Index d = spec.dim, n = spec.positions();
+  const Eigen::MatrixXd point_minv =
+      spec.mass.llt().solve(Eigen::MatrixXd::Identity(spec.points, spec.points));
+  Eigen::MatrixXd minv = Eigen::MatrixXd::Zero(n, n);
+  for (Index i = 0; i < spec.points; ++i)
+    for (Index j = 0; j < spec.points; ++j)
+      for (Index a = 0; a < d; ++a) minv(i * d + a, j * d + a) = point_minv(i, j);
+  return minv;
+}
+
+/// The state (x, v) with v = u projected M-orthogonally onto G(x) v = 0.
+inline Eigen::RowVectorXd tangent_state(const ConstraintSpec& spec, const Eigen::VectorXd& x,
+                                        const Eigen::VectorXd& u) {
+  const Eigen::MatrixXd minv = inverse_mass(spec), g = constraint_jacobian(spec, x);
+  const Eigen::MatrixXd s = g * minv * g.transpose();
+  const Eigen::VectorXd v = u - minv * g.transpose() * s.llt().solve(g * u);
+  Eigen::RowVectorXd z(2 * x.size());
+  z << x.transpose(), v.transpose();
+  return z;
 }
 
 /// Random states on the manifold of a chain spec: each point at its length from the one before
@@ -62,12 +91,6 @@ inline Matrix<double> chain_states(const ConstraintSpec& spec, Index rows, std::
   std::mt19937_64 rng(seed);
   std::normal_distribution<double> normal;
   const Index d = spec.dim, n = spec.positions();
-  const Eigen::MatrixXd point_minv =
-      spec.mass.llt().solve(Eigen::MatrixXd::Identity(spec.points, spec.points));
-  Eigen::MatrixXd minv = Eigen::MatrixXd::Zero(n, n);  // M^-1 on each axis
-  for (Index i = 0; i < spec.points; ++i)
-    for (Index j = 0; j < spec.points; ++j)
-      for (Index a = 0; a < d; ++a) minv(i * d + a, j * d + a) = point_minv(i, j);
   Matrix<double> z(rows, 2 * n);
   for (Index r = 0; r < rows; ++r) {
     Eigen::VectorXd x(n), u(n);
@@ -81,10 +104,7 @@ inline Matrix<double> chain_states(const ConstraintSpec& spec, Index rows, std::
       x.segment(k * d, d) = from + length * dir.normalized();
     }
     for (Index i = 0; i < n; ++i) u(i) = normal(rng);
-    const Eigen::MatrixXd g = constraint_jacobian(spec, x);
-    const Eigen::MatrixXd s = g * minv * g.transpose();
-    const Eigen::VectorXd v = u - minv * g.transpose() * s.llt().solve(g * u);
-    z.row(r) << x.transpose(), v.transpose();
+    z.row(r) = tangent_state(spec, x, u);
   }
   return z;
 }

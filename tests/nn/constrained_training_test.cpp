@@ -28,6 +28,22 @@ nn::ConstraintSpec double_chain() {
   return chain_spec({1.0, 0.8}, 2, mass, {0.1, 0.2});
 }
 
+// Two points in 2-D on a link, a weighted point between them pinned (a ball joint), and states
+// near it: x_0 near (-0.5, 0), x_1 near (0.5, 0).
+nn::ConstraintSpec pinned_pair() {
+  nn::ConstraintSpec spec = chain_spec({1.0, 1.0}, 2, Eigen::MatrixXd::Identity(2, 2), {0, 0});
+  spec.anchors.clear();
+  spec.pins.push_back({{0.6, 0.4}, {0.1, 0.0}});
+  return spec;
+}
+
+MatrixD pinned_pair_states(std::mt19937_64& rng) {
+  MatrixD z = 0.2 * nn::random_uniform<double>(2, 8, rng, -1, 1);
+  z.col(0).array() -= 0.5;
+  z.col(2).array() += 0.5;
+  return z;
+}
+
 // The message of the std::invalid_argument that making a model from `config` throws.
 std::string config_error(const nn::DynamicsConfig& config) {
   try {
@@ -67,20 +83,23 @@ TEST(ConstrainedTraining, LossGradientsMatchFiniteDifferencesToSecondOrder) {
 }
 
 TEST(ConstrainedTraining, MechanicsDifferentiateInStateAndPotentialGradient) {
-  const nn::ConstrainedMechanics<double> mechanics(double_chain());
-  std::mt19937_64 rng(23);
-  const std::vector<MatrixD> inputs{nn::testing::chain_states(double_chain(), 2, 24),
-                                    nn::random_uniform<double>(2, 4, rng, -1, 1)};
-  const auto hamiltonian = [&](const std::vector<Var<double>>& in) {
-    return ad::sum(ad::sin(mechanics.hamiltonian_field(in[0], in[1])));
-  };
-  const auto lagrangian = [&](const std::vector<Var<double>>& in) {
-    return ad::sum(ad::sin(mechanics.lagrangian_field(in[0], in[1])));
-  };
-  for (const ad::CheckResult& check :
-       {ad::gradcheck(hamiltonian, inputs), ad::gradgradcheck(hamiltonian, inputs),
-        ad::gradcheck(lagrangian, inputs), ad::gradgradcheck(lagrangian, inputs)}) {
-    EXPECT_TRUE(check.ok) << check.worst << "\n" << check.log;
+  for (const nn::ConstraintSpec& spec : {double_chain(), pinned_pair()}) {
+    const nn::ConstrainedMechanics<double> mechanics(spec);
+    std::mt19937_64 rng(23);
+    const std::vector<MatrixD> inputs{
+        spec.pins.empty() ? nn::testing::chain_states(spec, 2, 24) : pinned_pair_states(rng),
+        nn::random_uniform<double>(2, 4, rng, -1, 1)};
+    const auto hamiltonian = [&](const std::vector<Var<double>>& in) {
+      return ad::sum(ad::sin(mechanics.hamiltonian_field(in[0], in[1])));
+    };
+    const auto lagrangian = [&](const std::vector<Var<double>>& in) {
+      return ad::sum(ad::sin(mechanics.lagrangian_field(in[0], in[1])));
+    };
+    for (const ad::CheckResult& check :
+         {ad::gradcheck(hamiltonian, inputs), ad::gradgradcheck(hamiltonian, inputs),
+          ad::gradcheck(lagrangian, inputs), ad::gradgradcheck(lagrangian, inputs)}) {
+      EXPECT_TRUE(check.ok) << check.worst << "\n" << check.log;
+    }
   }
 }
 
@@ -162,4 +181,12 @@ TEST(ConstrainedTraining, ConfigsThatCannotMakeTheModelAreRefused) {
   c = config;
   c.constraints.anchors[0].length = 0;
   refused(c, "has length 0");
+  c = config;
+  c.constraints.pins.push_back({{1.0}, {0.0, 0.0}});
+  refused(c, "pin 0 needs 2 finite weights (one per point), got 1");
+  c.constraints.pins[0].weights = {0.0, 0.0};
+  refused(c, "pin 0 has only zero weights");
+  c.constraints.pins[0].weights = {0.5, 0.5};
+  c.constraints.pins[0].point = {0.0, 0.0, 1.0};
+  refused(c, "pin 0 needs a fixed point of 2 finite coordinates, got 3");
 }
