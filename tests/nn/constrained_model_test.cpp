@@ -126,16 +126,6 @@ MatrixD manifold_states(const nn::ConstraintSpec& spec, Eigen::Index rows, std::
   return z;
 }
 
-template <typename F>
-std::string error_of(F f) {
-  try {
-    f();
-  } catch (const ad::Error& e) {
-    return e.what();
-  }
-  return "";
-}
-
 }  // namespace constrained_model_test
 
 using namespace constrained_model_test;
@@ -257,6 +247,6 @@ TEST(ConstrainedFields, DegenerateConstraintsNameTheRow) {
   const nn::ConstrainedModel<double> chnn(constrained_config(ModelKind::kChnn, spec, {4}), rng);
   MatrixD z = nn::testing::chain_states(spec, 3, 11);
   z.block(1, 2, 1, 2) = z.block(1, 0, 1, 2);  // row 1: the link's two points coincide
-  const std::string message = error_of([&] { chnn.field(z); });
+  const std::string message = nn::testing::message_of<ad::Error>([&] { chnn.field(z); });
   EXPECT_NE(message.find("block 1 of 3 is not positive definite"), std::string::npos) << message;
 }

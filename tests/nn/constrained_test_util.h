@@ -6,6 +6,7 @@
 #include <Eigen/Cholesky>
 #include <cmath>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "nn/nn.h"
@@ -23,6 +24,17 @@ inline ConstraintSpec chain_spec(const std::vector<double>& lengths, Index dim,
   spec.anchors.push_back({0, std::move(pivot), lengths[0]});
   for (Index k = 1; k < spec.points; ++k) spec.links.push_back({k - 1, k, lengths[std::size_t(k)]});
   return spec;
+}
+
+/// The message of the E that f throws ("" when it throws none).
+template <typename E, typename F>
+std::string message_of(F f) {
+  try {
+    f();
+  } catch (const E& e) {
+    return e.what();
+  }
+  return "";
 }
 
 /// A CHNN or CLNN config for `spec` with a small tanh MLP.

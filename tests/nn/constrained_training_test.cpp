@@ -46,13 +46,10 @@ MatrixD pinned_pair_states(std::mt19937_64& rng) {
 
 // The message of the std::invalid_argument that making a model from `config` throws.
 std::string config_error(const nn::DynamicsConfig& config) {
-  try {
+  return nn::testing::message_of<std::invalid_argument>([&] {
     std::mt19937_64 rng(0);
     nn::make_model<double>(config, rng);
-  } catch (const std::invalid_argument& e) {
-    return e.what();
-  }
-  return "";
+  });
 }
 
 }  // namespace constrained_training_test
