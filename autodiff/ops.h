@@ -113,6 +113,16 @@ Var<T> batched_matvec(const Var<T>& a, const Var<T>& v, bool transpose_a = false
 template <typename T>
 Var<T> batched_outer(const Var<T>& u, const Var<T>& v);
 
+/// X (R x n) with sym(A_r) x_r = b_r, sym(A) = (A + A^T) / 2 symmetric positive definite (the
+/// Gram blocks G M^-1 G^T of constrained mechanics, nn/constrained/): Cholesky per row, half the
+/// work of batched_solve's LU and allocation-free at any n. Reading only sym(A) keeps the
+/// derivative exact for any input: d/db = gb = batched_spd_solve(a, g); d/da = -(batched_outer(gb,
+/// x) + batched_outer(x, gb)) / 2. Throws hnn::ad::Error naming the row of a block that is not
+/// finite, not positive definite, or whose 1-norm rcond is below kBatchedSolveMinRcond (computed
+/// exactly from the inverse), or of a non-finite right-hand side.
+template <typename T>
+Var<T> batched_spd_solve(const Var<T>& a, const Var<T>& b);
+
 // ---- reductions and shapes -------------------------------------------------------------------
 template <typename T>
 Var<T> sum(const Var<T>& a);  // -> 1x1

@@ -23,7 +23,42 @@ FieldType parse_field_type(std::string_view name) {
   return parse_name(kFieldTypeNames, name, "field type");
 }
 
+namespace {
+
+// A CHNN or CLNN needs its system, and sees positions only: no angles, no input scales. Any other
+// model refuses a system it would ignore.
+void validate_constraints(const DynamicsConfig& config) {
+  if (!is_constrained(config.model)) {
+    if (!config.constraints.empty()) {
+      throw std::invalid_argument(
+          fmt::format("model: a {} model takes no constraints (only chnn and clnn do)",
+                      to_string(config.model)));
+    }
+    return;
+  }
+  if (config.constraints.empty()) {
+    throw std::invalid_argument(
+        fmt::format("model: a {} model needs the constrained system (DynamicsConfig::constraints)",
+                    to_string(config.model)));
+  }
+  validate(config.constraints);
+  if (config.dim != 2 * config.constraints.positions()) {
+    throw std::invalid_argument(
+        fmt::format("model: a {} state of {} points in {} dimensions has dim {}, got {}",
+                    to_string(config.model), config.constraints.points, config.constraints.dim,
+                    2 * config.constraints.positions(), config.dim));
+  }
+  if (config.angles != 0 || !config.input_scale.empty()) {
+    throw std::invalid_argument(fmt::format(
+        "model: a {} model takes Cartesian positions as they are: no angles, no input_scale",
+        to_string(config.model)));
+  }
+}
+
+}  // namespace
+
 void validate(const DynamicsConfig& config) {
+  validate_constraints(config);
   if (config.dim < 1) {
     throw std::invalid_argument(fmt::format("model: state dimension {} must be >= 1", config.dim));
   }
@@ -72,11 +107,12 @@ void validate(const DynamicsConfig& config) {
 MlpConfig mlp_config(const DynamicsConfig& config) {
   validate(config);
   MlpConfig mlp;
-  mlp.widths.push_back(config.dim + config.angles);  // an angle is seen as (cos, sin)
+  // An angle is seen as (cos, sin); a constrained model's MLP sees the positions only.
+  mlp.widths.push_back(is_constrained(config.model) ? config.dim / 2 : config.dim + config.angles);
   mlp.widths.insert(mlp.widths.end(), config.hidden.begin(), config.hidden.end());
   Index out = config.dim;
   if (learns_scalars(config.model)) out = config.field == FieldType::kBoth ? 2 : 1;
-  if (config.model == ModelKind::kLnn) out = 1;
+  if (config.model == ModelKind::kLnn || is_constrained(config.model)) out = 1;
   mlp.widths.push_back(out);
   mlp.activation = config.activation;
   mlp.init = config.init;
@@ -99,7 +135,9 @@ DynamicsModel<T>::DynamicsModel(DynamicsConfig config, Mlp<T> mlp)
 template <typename T>
 std::string DynamicsModel<T>::name() const {
   if (config_.model == ModelKind::kBaseline) return "baseline";
-  if (config_.model == ModelKind::kLnn) return "lnn";
+  if (config_.model == ModelKind::kLnn || is_constrained(config_.model)) {
+    return std::string(to_string(config_.model));
+  }
   switch (config_.field) {
     case FieldType::kSolenoidal:
       return "hnn";

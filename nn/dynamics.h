@@ -6,6 +6,7 @@
 #include <string_view>
 #include <vector>
 
+#include "nn/constrained/constraints.h"
 #include "nn/enum_names.h"
 #include "nn/mlp.h"
 
@@ -17,6 +18,11 @@ enum class ModelKind {
   kBaseline,  // an MLP that outputs dx/dt directly
   kDhnn,      // the dissipative HNN (Sosanya & Greydanus 2022): an HNN whose field type is kBoth
   kLnn,       // the Lagrangian NN (Cranmer et al. 2020): a learned L(q, v), x = (q, v = dq/dt)
+  // Finzi, Wang & Wilson 2020, in Cartesian coordinates x = (positions, velocities) of a
+  // DynamicsConfig::constraints system: a learned potential V(positions), the known mass matrix,
+  // and the constraint forces from multipliers (nn/constrained/constrained_model.h).
+  kChnn,  // the constrained Hamiltonian NN: J dH projected onto the constraints
+  kClnn,  // the constrained Lagrangian NN: M a = -dV - DPhi^T lambda
 };
 
 /// How an HNN turns learned scalars into a field (the reference's field_type).
@@ -30,15 +36,24 @@ enum class FieldType {
 inline bool learns_scalars(ModelKind kind) {
   return kind == ModelKind::kHnn || kind == ModelKind::kDhnn;
 }
-/// Whether the state's second half is velocities dq/dt (an LNN's), not canonical momenta.
+/// Whether a model of this kind learns a potential of a constrained system (CHNN, CLNN).
+inline bool is_constrained(ModelKind kind) {
+  return kind == ModelKind::kChnn || kind == ModelKind::kClnn;
+}
+/// Whether the state's second half is velocities dq/dt (an LNN's), not canonical momenta, of the
+/// task's own coordinates. (A CHNN's and a CLNN's are velocities too, but of the Cartesian points
+/// of DynamicsConfig::constraints, which no task in generalised coordinates has.)
 inline bool needs_velocities(ModelKind kind) { return kind == ModelKind::kLnn; }
 
-/// The names: "hnn", "baseline", "dhnn", "lnn"; "solenoidal", "conservative", "both".
-inline constexpr NameTable<ModelKind, 4> kModelKindNames{{
+/// The names: "hnn", "baseline", "dhnn", "lnn", "chnn", "clnn"; "solenoidal", "conservative",
+/// "both".
+inline constexpr NameTable<ModelKind, 6> kModelKindNames{{
     {ModelKind::kHnn, "hnn"},
     {ModelKind::kBaseline, "baseline"},
     {ModelKind::kDhnn, "dhnn"},
     {ModelKind::kLnn, "lnn"},
+    {ModelKind::kChnn, "chnn"},
+    {ModelKind::kClnn, "clnn"},
 }};
 inline constexpr NameTable<FieldType, 3> kFieldTypeNames{{
     {FieldType::kSolenoidal, "solenoidal"},
@@ -74,10 +89,14 @@ struct DynamicsConfig {
   /// many states, and the loss there is enormous); the MLP learns the rest, and can cancel
   /// the term. 0: Cranmer et al.'s plain L = MLP.
   double kinetic_prior = 1.0;
+  /// CHNN and CLNN only (empty for the others): the system, whose state x = (positions,
+  /// velocities) has dim = 2 N d. Their MLP sees the positions only and learns V.
+  ConstraintSpec constraints{};
 };
 
 /// The MLP of a model: dim -> hidden... -> out, with out = dim for the baseline, the number of
-/// learned scalars for an HNN (1, or 2 for kBoth: column 0 is H, column 1 is D), 1 (L) for an LNN.
+/// learned scalars for an HNN (1, or 2 for kBoth: column 0 is H, column 1 is D), 1 (L) for an LNN;
+/// N d -> hidden... -> 1 (V of the positions) for a CHNN or CLNN.
 MlpConfig mlp_config(const DynamicsConfig& config);
 /// Throws std::invalid_argument when the config cannot make a model (odd HNN dim, ...).
 void validate(const DynamicsConfig& config);
@@ -98,7 +117,7 @@ class DynamicsModel : public Module<T> {
   const DynamicsConfig& config() const { return config_; }
   Index dim() const { return config_.dim; }
   const Mlp<T>& mlp() const { return mlp_; }
-  /// "hnn", "hnn-conservative", "hnn-dissipative" (kBoth), "lnn" or "baseline".
+  /// "hnn", "hnn-conservative", "hnn-dissipative" (kBoth), "lnn", "chnn", "clnn" or "baseline".
   std::string name() const;
   /// name() + ":" + activation, e.g. "hnn:tanh": what checkpoints record and check.
   std::string kind() const override;

@@ -6,6 +6,7 @@
 
 #include "autodiff/ops.h"
 #include "autodiff/tape.h"
+#include "nn/constrained/constrained_model.h"
 #include "nn/lnn.h"
 
 namespace hnn::nn {
@@ -14,7 +15,8 @@ namespace {
 
 // An Hnn is built from a kHnn or kDhnn config, a Baseline from a kBaseline one.
 const DynamicsConfig& require(const DynamicsConfig& config, ModelKind kind) {
-  if (learns_scalars(config.model) != learns_scalars(kind) || config.model == ModelKind::kLnn) {
+  if (learns_scalars(config.model) != learns_scalars(kind) || config.model == ModelKind::kLnn ||
+      is_constrained(config.model)) {
     throw std::invalid_argument(fmt::format("a {} model cannot be built from a '{}' config",
                                             to_string(kind), to_string(config.model)));
   }
@@ -144,6 +146,7 @@ Matrix<T> Baseline<T>::field(const MatrixView<T>& x) const {
 template <typename T>
 std::unique_ptr<DynamicsModel<T>> make_model(const DynamicsConfig& config, std::mt19937_64& rng) {
   if (config.model == ModelKind::kLnn) return std::make_unique<Lnn<T>>(config, rng);
+  if (is_constrained(config.model)) return std::make_unique<ConstrainedModel<T>>(config, rng);
   if (learns_scalars(config.model)) return std::make_unique<Hnn<T>>(config, rng);
   return std::make_unique<Baseline<T>>(config, rng);
 }
@@ -153,6 +156,9 @@ std::unique_ptr<DynamicsModel<U>> cast_model(const DynamicsModel<T>& model) {
   Mlp<U> mlp = model.mlp().template cast<U>();
   if (model.config().model == ModelKind::kLnn) {
     return std::make_unique<Lnn<U>>(model.config(), std::move(mlp));
+  }
+  if (is_constrained(model.config().model)) {
+    return std::make_unique<ConstrainedModel<U>>(model.config(), std::move(mlp));
   }
   if (learns_scalars(model.config().model)) {
     return std::make_unique<Hnn<U>>(model.config(), std::move(mlp));

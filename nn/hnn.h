@@ -66,7 +66,8 @@ class Baseline : public DynamicsModel<T> {
   }
 };
 
-/// An Hnn or a Baseline, as config.model says, initialised from `rng`.
+/// An Hnn, Lnn, ConstrainedModel (chnn, clnn) or Baseline, as config.model says, initialised
+/// from `rng`.
 template <typename T>
 std::unique_ptr<DynamicsModel<T>> make_model(const DynamicsConfig& config, std::mt19937_64& rng);
 

@@ -1,6 +1,7 @@
 // A recorded batched_solve and its backward (first and second order) allocate nothing on the
 // heap once warmed up inside a reused TapeScope: the LU works in fixed-size storage for blocks up
-// to 4x4 and every node's buffer is recycled. Counted by tests/malloc_counter.cpp, linked into
+// to 4x4 and every node's buffer is recycled. batched_spd_solve likewise, at any block size (its
+// Cholesky works in the node's recycled buffers). Counted by tests/malloc_counter.cpp, linked into
 // the autodiff test program.
 
 #include <gtest/gtest.h>
@@ -20,8 +21,10 @@ namespace {
 
 // Heap allocations of `steps` steps after `warmup`: x = solve(A, b), loss = sum(x^2), its
 // gradient with create_graph, and the gradient of |grad|^2 (the backward's own backward).
-template <typename T>
-long AllocationsOfSolveSteps(Eigen::Index rows, Eigen::Index n, int warmup, int steps) {
+template <typename T, typename Solve = decltype(&ad::batched_spd_solve<T>)>
+long AllocationsOfSolveSteps(
+    Eigen::Index rows, Eigen::Index n, int warmup, int steps,
+    Solve solve = [](const Var<T>& a, const Var<T>& b) { return ad::batched_solve(a, b); }) {
   MatrixD a = ad::testing::random_matrix(rows, n * n, 1, -0.5, 0.5);
   for (Eigen::Index r = 0; r < rows; ++r)
     for (Eigen::Index i = 0; i < n; ++i) a(r, i * n + i) += 2.0;
@@ -33,7 +36,7 @@ long AllocationsOfSolveSteps(Eigen::Index rows, Eigen::Index n, int warmup, int 
     const long before = hnn::testing::allocation_count();
     {
       ad::TapeScope scope;
-      const Var<T> x = ad::batched_solve(inputs[0], inputs[1]);
+      const Var<T> x = solve(inputs[0], inputs[1]);
       ad::grad_into(ad::sum(ad::square(x)), inputs, first, {.create_graph = true});
       ad::grad_into(ad::sum(ad::square(first[0])) + ad::sum(ad::square(first[1])), inputs, second);
     }
@@ -49,6 +52,19 @@ TEST(BatchedAllocations, SolveAndItsDerivativesAllocateNothingAfterWarmUp) {
   for (Eigen::Index n : {2, 4}) {
     EXPECT_EQ(AllocationsOfSolveSteps<double>(512, n, 3, 10), 0) << "double, n " << n;
     EXPECT_EQ(AllocationsOfSolveSteps<float>(512, n, 3, 10), 0) << "float, n " << n;
+  }
+#endif
+}
+
+TEST(BatchedAllocations, SpdSolveAndItsDerivativesAllocateNothingAfterWarmUpAtAnySize) {
+#if !HNN_COUNTS_ALLOCATIONS
+  GTEST_SKIP() << "malloc belongs to the sanitizer in this build";
+#else
+  for (Eigen::Index n : {2, 5}) {  // above 4, where batched_solve's LU allocates
+    EXPECT_EQ(AllocationsOfSolveSteps<double>(256, n, 3, 10, &ad::batched_spd_solve<double>), 0)
+        << "double, n " << n;
+    EXPECT_EQ(AllocationsOfSolveSteps<float>(256, n, 3, 10, &ad::batched_spd_solve<float>), 0)
+        << "float, n " << n;
   }
 #endif
 }

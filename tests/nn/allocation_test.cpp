@@ -9,6 +9,7 @@
 #include <random>
 
 #include "autodiff/autodiff.h"
+#include "constrained_test_util.h"
 #include "malloc_counter.h"
 #include "nn/nn.h"
 
@@ -107,6 +108,24 @@ TEST(Allocations, DissipativeAndLagrangianStepsAllocateNothingAfterWarmUp) {
     wide.hidden = {128, 128};
     EXPECT_EQ(allocations_per_steps<float>(wide, threads, 512, 2, 3), 0)
         << "LNN 128-128, 512 rows, float, " << threads << " thread(s)";
+  }
+}
+
+TEST(Allocations, ConstrainedStepsAllocateNothingAfterWarmUp) {
+#if !HNN_COUNTS_ALLOCATIONS
+  GTEST_SKIP() << "malloc belongs to the sanitizer in this build";
+#endif
+  // A 3-chain in 2-D: the Gram blocks of its multipliers are 3x3.
+  const nn::ConstraintSpec spec =
+      nn::testing::chain_spec({1.0, 0.8, 0.6}, 2, Eigen::MatrixXd::Identity(3, 3), {0.0, 0.0});
+  for (nn::ModelKind kind : {nn::ModelKind::kChnn, nn::ModelKind::kClnn}) {
+    const nn::DynamicsConfig config = nn::testing::constrained_config(kind, spec, {32, 32});
+    for (int threads : {1, 2}) {
+      EXPECT_EQ(allocations_per_steps<double>(config, threads, 64, 3, 10), 0)
+          << nn::to_string(kind) << ", double, " << threads << " thread(s)";
+      EXPECT_EQ(allocations_per_steps<float>(config, threads, 64, 3, 10), 0)
+          << nn::to_string(kind) << ", float, " << threads << " thread(s)";
+    }
   }
 }
 

@@ -1,0 +1,190 @@
+#include "nn/constrained/mechanics.h"
+
+#include <Eigen/Cholesky>
+
+#include "autodiff/ops.h"
+
+namespace hnn::nn {
+
+namespace {
+
+using Eigen::Index;
+
+// Block b's axis k is the constraint row(b, k): a link's or an anchor's one row for all its axes
+// (phi = |e|^2 / 2), a pin's own row per axis (e = 0).
+struct BlockRows {
+  Index distances, d;
+  Index row(Index b, Index k) const {
+    return b < distances ? b : distances + (b - distances) * d + k;
+  }
+};
+
+BlockRows block_rows(const ConstraintSpec& spec) {
+  return {Index(spec.links.size() + spec.anchors.size()), spec.dim};
+}
+
+// blocks x N: e_b = sum_j b(b, j) x_j - offset_b. +1 at a distance's first point, -1 at a link's
+// second; a pin's weights, or zeros (`with_pins` false: a pin's e is a constant, and Gdot's rows
+// for it vanish).
+Eigen::MatrixXd incidence(const ConstraintSpec& spec, bool with_pins) {
+  Eigen::MatrixXd b = Eigen::MatrixXd::Zero(spec.blocks(), spec.points);
+  Index c = 0;
+  for (const Link& link : spec.links) {
+    b(c, link.i) = 1;
+    b(c++, link.j) = -1;
+  }
+  for (const Anchor& anchor : spec.anchors) b(c++, anchor.i) = 1;
+  for (const Pin& pin : spec.pins) {
+    if (with_pins) b.row(c) = Eigen::Map<const Eigen::RowVectorXd>(pin.weights.data(), spec.points);
+    ++c;
+  }
+  return b;
+}
+
+// a (x) I_d in the point-major layout of a state (point i's axis k at i d + k).
+Eigen::MatrixXd per_axis(const Eigen::MatrixXd& a, Index d) {
+  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(a.rows() * d, a.cols() * d);
+  for (Index i = 0; i < a.rows(); ++i)
+    for (Index j = 0; j < a.cols(); ++j)
+      for (Index k = 0; k < d; ++k) out(i * d + k, j * d + k) = a(i, j);
+  return out;
+}
+
+Eigen::MatrixXd symmetric_inverse(const Eigen::MatrixXd& m) {
+  const Eigen::MatrixXd inverse = m.llt().solve(Eigen::MatrixXd::Identity(m.rows(), m.cols()));
+  return (0.5 * (inverse + inverse.transpose())).eval();
+}
+
+// (blocks d)^2 x C^2: S = outer(E, E) * gram has S(row(b, k), row(b', k)) += B_bb' e_b[k] e_b'[k],
+// where a pin's e is 1 on every axis: e_c . e_c' B_cc' between distances, e_c[k] B_cp between a
+// distance and a pin's axis k, B_pp' between a pin's and another's same axis.
+Eigen::MatrixXd gram_operator(const Eigen::MatrixXd& b_gram, const BlockRows& rows, Index c_count) {
+  const Index blocks = b_gram.rows(), d = rows.d, width = blocks * d;
+  Eigen::MatrixXd gram = Eigen::MatrixXd::Zero(width * width, c_count * c_count);
+  for (Index b = 0; b < blocks; ++b)
+    for (Index b2 = 0; b2 < blocks; ++b2)
+      for (Index k = 0; k < d; ++k)
+        gram((b * d + k) * width + b2 * d + k, rows.row(b, k) * c_count + rows.row(b2, k)) =
+            b_gram(b, b2);
+  return gram;
+}
+
+template <typename T>
+ad::Var<T> constant(const Matrix<T>& m) {
+  return ad::Var<T>::constant(m);
+}
+
+}  // namespace
+
+template <typename T>
+struct ConstrainedMechanics<T>::Geometry {
+  ad::Var<T> x, v;         // R x N d
+  ad::Var<T> e, w;         // R x blocks d: e_b and w_b = de_b/dt
+  ad::Var<T> gram;         // the constant gram_
+  ad::Var<T> s;            // R x C^2: S = G M^-1 G^T
+  ad::Var<T> to_velocity;  // the constant M^-1 D^T
+};
+
+template <typename T>
+ConstrainedMechanics<T>::ConstrainedMechanics(const ConstraintSpec& spec) : spec_(spec) {
+  validate(spec_);
+  const Index d = spec_.dim, c_count = spec_.constraints();
+  const BlockRows rows = block_rows(spec_);
+  const Eigen::MatrixXd b = incidence(spec_, true), minv = symmetric_inverse(spec_.mass);
+  const Eigen::MatrixXd b_gram = b * minv * b.transpose(), inverse = per_axis(minv, d);
+  mass_ = per_axis(spec_.mass, d).cast<T>();
+  inverse_ = inverse.cast<T>();
+  incidence_ = per_axis(incidence(spec_, false), d).transpose().cast<T>();
+  full_incidence_ = per_axis(b, d).transpose().cast<T>();
+  inverse_incidence_ = (inverse * per_axis(b, d).transpose()).cast<T>();
+  offsets_ = Matrix<T>::Zero(1, spec_.blocks() * d);
+  group_ = Matrix<T>::Zero(spec_.blocks() * d, c_count);
+  for (Index block = 0; block < spec_.blocks(); ++block) {
+    const Index anchor = block - Index(spec_.links.size());  // an anchor's index when >= 0
+    for (Index k = 0; k < d; ++k) {
+      if (block >= rows.distances)
+        offsets_(0, block * d + k) = T(-1);  // a pin's e is 1
+      else if (anchor >= 0)
+        offsets_(0, block * d + k) = T(spec_.anchors[std::size_t(anchor)].point[std::size_t(k)]);
+      group_(block * d + k, rows.row(block, k)) = T(1);
+    }
+  }
+  gram_ = gram_operator(0.5 * (b_gram + b_gram.transpose()), rows, c_count).cast<T>();
+}
+
+template <typename T>
+typename ConstrainedMechanics<T>::Geometry ConstrainedMechanics<T>::geometry(
+    const ad::Var<T>& z) const {
+  const Index n = spec_.positions();
+  HNN_AD_CHECK(z.cols() == 2 * n,
+               "constrained field: states {} are not R x {} (x then v of {} "
+               "points in {} dimensions)",
+               z.shape(), 2 * n, spec_.points, spec_.dim);
+  Geometry g;
+  g.x = ad::slice_cols(z, 0, n);
+  g.v = ad::slice_cols(z, n, n);
+  const ad::Var<T> incidence = constant(incidence_);
+  g.e = ad::matmul(g.x, incidence);
+  if (!spec_.anchors.empty() || !spec_.pins.empty()) g.e = g.e - constant(offsets_);
+  g.w = ad::matmul(g.v, incidence);
+  g.gram = constant(gram_);
+  g.s = ad::matmul(ad::batched_outer(g.e, g.e), g.gram);
+  g.to_velocity = constant(inverse_incidence_);
+  return g;
+}
+
+template <typename T>
+ad::Var<T> ConstrainedMechanics<T>::group(const ad::Var<T>& y) const {
+  return ad::matmul(y, constant(group_));
+}
+
+template <typename T>
+ad::Var<T> ConstrainedMechanics<T>::expand(const ad::Var<T>& l) const {
+  return ad::matmul(l, constant(group_), false, true);
+}
+
+template <typename T>
+ad::Var<T> ConstrainedMechanics<T>::hamiltonian_field(const ad::Var<T>& z,
+                                                      const ad::Var<T>& dv) const {
+  const Geometry g = geometry(z);
+  const ad::Var<T> free_acceleration = -ad::matmul(dv, constant(inverse_));
+  if (spec_.constraints() == 0) return ad::concat_cols<T>({g.v, free_acceleration});
+  // DPsi f = (r1, r2) = (G v, Gdot v - G M^-1 dV). A pin's G v is its e's rate, which w leaves
+  // out (its Gdot is zero).
+  const ad::Var<T> rate = spec_.pins.empty() ? g.w : ad::matmul(g.v, constant(full_incidence_));
+  const ad::Var<T> r1 = group(g.e * rate);
+  const ad::Var<T> r2 = group(g.w * g.w - g.e * ad::matmul(dv, g.to_velocity));
+  const ad::Var<T> k =
+      ad::matmul(ad::batched_outer(g.w, g.e) - ad::batched_outer(g.e, g.w), g.gram);
+  const ad::Var<T> nu = ad::batched_spd_solve(g.s, r1);  // S nu = r1
+  const ad::Var<T> mu = ad::batched_spd_solve(g.s, ad::batched_matvec(k, nu) - r2);
+  // z' = f - J DPsi^T (mu, nu): x' = v - M^-1 G^T nu, p' = -dV + G^T mu + Gdot^T nu.
+  const ad::Var<T> nu_e = g.e * expand(nu);
+  const ad::Var<T> x_dot = g.v - ad::matmul(nu_e, g.to_velocity, false, true);
+  const ad::Var<T> v_dot = free_acceleration + ad::matmul(g.e * expand(mu) + g.w * expand(nu),
+                                                          g.to_velocity, false, true);
+  return ad::concat_cols<T>({x_dot, v_dot});
+}
+
+template <typename T>
+ad::Var<T> ConstrainedMechanics<T>::lagrangian_field(const ad::Var<T>& z,
+                                                     const ad::Var<T>& dv) const {
+  const Geometry g = geometry(z);
+  const ad::Var<T> free_acceleration = -ad::matmul(dv, constant(inverse_));
+  if (spec_.constraints() == 0) return ad::concat_cols<T>({g.v, free_acceleration});
+  const ad::Var<T> rhs = group(g.w * g.w - g.e * ad::matmul(dv, g.to_velocity));
+  const ad::Var<T> lambda = ad::batched_spd_solve(g.s, rhs);
+  const ad::Var<T> a =
+      free_acceleration - ad::matmul(g.e * expand(lambda), g.to_velocity, false, true);
+  return ad::concat_cols<T>({g.v, a});
+}
+
+template <typename T>
+Matrix<T> ConstrainedMechanics<T>::kinetic_energy(const Matrix<T>& v) const {
+  return (T(0.5) * (v * mass_).cwiseProduct(v).rowwise().sum()).eval();
+}
+
+template class ConstrainedMechanics<float>;
+template class ConstrainedMechanics<double>;
+
+}  // namespace hnn::nn
