@@ -59,7 +59,7 @@ ad::Var<T> ConstrainedModel<T>::time_derivative(const ad::Var<T>& x) const {
 }
 
 template <typename T>
-Matrix<T> ConstrainedModel<T>::field(const Matrix<T>& x) const {
+Matrix<T> ConstrainedModel<T>::field(const MatrixView<T>& x) const {
   this->check_input("field", x.rows(), x.cols());
   ad::TapeScope scope;
   ad::NoGradGuard values_only;
