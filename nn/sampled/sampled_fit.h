@@ -36,12 +36,21 @@ enum class LeastSquaresSolver {
   kCholesky,  // the regularised normal equations (A^T A + lambda I) c = A^T b, by Cholesky
   kQr,        // LAPACK's dgelsd (SVD-based, like np.linalg.lstsq) on A, or for one hidden layer
               // on its reduction by a QR of D (docs/sampled.md)
+  kRidge,     // qr's reduction, then Tikhonov on its triangle R: the QR of [R; mu I] by dtpqrt,
+              // mu = rcond times R's largest singular value, and one triangular solve
 };
-inline constexpr NameTable<LeastSquaresSolver, 3> kLeastSquaresSolverNames{{
+inline constexpr NameTable<LeastSquaresSolver, 4> kLeastSquaresSolverNames{{
     {LeastSquaresSolver::kLsqr, "lsqr"},
     {LeastSquaresSolver::kCholesky, "cholesky"},
     {LeastSquaresSolver::kQr, "qr"},
+    {LeastSquaresSolver::kRidge, "ridge"},
 }};
+
+/// Whether a solver reads SampledFitConfig::rcond (the others read regularization, and lsqr
+/// tolerance and max_iterations).
+constexpr bool reads_rcond(LeastSquaresSolver solver) {
+  return solver != LeastSquaresSolver::kLsqr && solver != LeastSquaresSolver::kCholesky;
+}
 
 /// Settings of a sampled fit. The defaults reproduce the peer's accuracy (docs/sampled.md).
 struct SampledFitConfig {
