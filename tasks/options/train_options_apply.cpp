@@ -1,7 +1,7 @@
 // apply(): where each option of `hnn train`'s table (train_options.cpp) lands in RunOptions.
 
-#include "tasks/options/train_options.h"
 #include "tasks/train/loop.h"
+#include "tasks/options/train_options.h"
 
 namespace hnn::tasks {
 
