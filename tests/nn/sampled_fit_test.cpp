@@ -37,6 +37,14 @@ Problem pendulum(int n, std::uint64_t seed, double damping = 0) {
   return out;
 }
 
+// `data` with Gaussian noise of standard deviation `sigma` added to its dx/dt.
+Problem with_noise(Problem data, double sigma, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> noise(0, sigma);
+  for (Index i = 0; i < data.dxdt.size(); ++i) data.dxdt.data()[i] += noise(rng);
+  return data;
+}
+
 DynamicsConfig model_config(ModelKind kind, std::vector<Index> hidden) {
   DynamicsConfig c;
   c.model = kind;
@@ -208,10 +216,7 @@ TEST(SampledFit, SingularSystemIsRefused) {
 // interpolates the noise, and a large cutoff wins.
 TEST(SampledFit, AutoRcondIsLargeOnNoisyDataAndSmallOnExactData) {
   const Problem exact = pendulum(300, 2);
-  Problem noisy = exact;
-  std::mt19937_64 rng(5);
-  std::normal_distribution<double> noise(0, 0.1);
-  for (Index i = 0; i < noisy.dxdt.size(); ++i) noisy.dxdt.data()[i] += noise(rng);
+  const Problem noisy = with_noise(exact, 0.1, 5);
   const auto chosen = [](const Problem& data) {
     std::mt19937_64 init(1);
     auto model = make_model<double>(model_config(ModelKind::kHnn, {100}), init);
@@ -237,10 +242,7 @@ TEST(SampledFit, AutoRcondIsLargeOnNoisyDataAndSmallOnExactData) {
 // large cutoff; then it refits at the chosen one.
 TEST(SampledFit, RidgeAutoRcondWalksTheLadderFromTheSmallest) {
   const Problem exact = pendulum(300, 2);
-  Problem noisy = exact;
-  std::mt19937_64 rng(5);
-  std::normal_distribution<double> noise(0, 0.1);
-  for (Index i = 0; i < noisy.dxdt.size(); ++i) noisy.dxdt.data()[i] += noise(rng);
+  const Problem noisy = with_noise(exact, 0.1, 5);
   const SampledFitConfig ridge{.solver = LeastSquaresSolver::kRidge};
   std::mt19937_64 init(1);
   auto on_exact = make_model<double>(model_config(ModelKind::kHnn, {100}), init);
@@ -269,10 +271,7 @@ TEST(SampledFit, RidgeAutoRcondWalksTheLadderFromTheSmallest) {
 // an explicit --rcond of that value (the hidden layers' draws do not see the split); the
 // baseline (several outputs, a formed matrix) alike.
 TEST(SampledFit, AutoRcondRefitsOnEveryPointAtTheChosenCutoff) {
-  Problem data = pendulum(300, 2);
-  std::mt19937_64 rng(7);
-  std::normal_distribution<double> noise(0, 0.05);
-  for (Index i = 0; i < data.dxdt.size(); ++i) data.dxdt.data()[i] += noise(rng);
+  const Problem data = with_noise(pendulum(300, 2), 0.05, 7);
   for (ModelKind kind : {ModelKind::kHnn, ModelKind::kBaseline}) {
     std::mt19937_64 init(1);
     auto automatic = make_model<double>(model_config(kind, {60}), init);
