@@ -152,13 +152,13 @@ int main(int argc, char** argv) try {
       "\"fit_seconds\": {:.2f}, \"sample_seconds\": {:.2f}, \"assemble_seconds\": {:.2f}, "
       "\"gram_seconds\": {:.2f}, \"solve_seconds\": {:.2f}, \"iterations\": {}, \"rows\": {}, "
       "\"columns\": {}, \"matrix_gb\": {:.2f}, \"peak_rss_gb\": {:.2f}, \"gram_gflops\": {:.1f}, "
-      "\"residual_rms\": {:.3e}}}\n",
+      "\"residual_rms\": {:.3e}, \"rcond\": {:g}, \"validation_seconds\": {:.2f}}}\n",
       arg(argc, argv, "system", "hh"), nn::name_of(nn::kHiddenSamplerNames, fit.sampler), r.solver,
       width, layers, train, shifted, pinned,
       r.sample_seconds + r.assemble_seconds + r.solve_seconds, r.sample_seconds, r.assemble_seconds,
       r.gram_seconds, r.solve_seconds, r.iterations, r.rows, r.columns,
       double(r.matrix_bytes) / 1e9, peak_rss_gb(), syrk_flops / r.gram_seconds * 1e-9,
-      r.residual_rms);
+      r.residual_rms, r.rcond, r.validation_seconds);
   return 0;
 } catch (const std::exception& e) {
   fmt::print(stderr, "sampled_fit_bench: {}\n", e.what());

@@ -201,6 +201,7 @@ RunSettings resolve(const Task& task, const RunOptions& o) {
 RunSettings validate(const RunOptions& o) {
   const RunSettings s = resolve(*make_task(o.task), o);
   if (!s.fit.steps()) check_sampled_options(o);
+  if (s.fit.samples()) check_solver_options(s.fit, o.task_settings, s.task);
   HNN_TASKS_CHECK(!o.checkpoint_every || *o.checkpoint_every > 0,
                   "--checkpoint-every must be positive, got {}", o.checkpoint_every.value_or(0));
   HNN_TASKS_CHECK(!o.out.empty(), "an output folder is required");

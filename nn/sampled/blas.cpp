@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 #include <vector>
 
@@ -119,6 +120,38 @@ int lstsq_svd(ColMat& a, ColMat& b, double rcond) {
     throw std::runtime_error(fmt::format("sampled fit: LAPACK dgelsd failed (info {})", info));
   }
   return rank;
+}
+
+void ridge_triangle(ColMat& r, ColMat& b, double mu) {
+  const Eigen::Index n = r.cols();
+  ColMat t = ColMat::Zero(n, n), d = ColMat::Zero(n, b.cols());
+  t.diagonal().setConstant(mu);
+  qr_merge_triangle(r, t, b, d);
+  solve_upper(r, false, b);
+}
+
+void reduce_to_triangle(ColMat& a, ColMat& b) {
+  bool triangle = a.rows() == a.cols();
+  for (Eigen::Index j = 0; triangle && j < a.cols(); ++j)
+    triangle = a.col(j).tail(a.rows() - j - 1).isZero(0);
+  if (!triangle) {
+    ColMat r = qr_apply(a, b);
+    a = std::move(r);
+  }
+  b.conservativeResize(a.cols(), Eigen::NoChange);
+}
+
+double largest_singular_value(const ColMat& r, int iterations) {
+  const auto upper = r.triangularView<Eigen::Upper>();
+  Eigen::VectorXd v = Eigen::VectorXd::Ones(r.cols()), u;
+  double sigma = 0;
+  for (int i = 0; i < iterations && v.norm() > 0; ++i) {
+    v.normalize();
+    u.noalias() = upper * v;
+    v.noalias() = upper.transpose() * u;
+    sigma = std::sqrt(v.norm());
+  }
+  return sigma;
 }
 
 }  // namespace hnn::nn::sampled

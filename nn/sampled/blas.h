@@ -39,5 +39,16 @@ void solve_upper(const ColMat& r, bool transpose, ColMat& y);
 /// rcond times the largest are dropped. a is destroyed; b (rows x m) returns x in its first
 /// a.cols() rows. Returns the effective rank; throws std::runtime_error when dgelsd fails.
 int lstsq_svd(ColMat& a, ColMat& b, double rcond);
+/// min |r x - b|^2 + mu^2 |x|^2 for an upper-triangular n x n r: the QR of [r; mu I] by dtpqrt
+/// (2/3 n^3 FLOP, a merge of qr_merge_triangle), then one triangular solve. r is overwritten by
+/// the stack's triangle; b (n x m) returns x.
+void ridge_triangle(ColMat& r, ColMat& b, double mu);
+/// The largest singular value of an upper-triangular r, from `iterations` power steps on r^T r
+/// (an estimate from below, matrix-vector products only: enough to place a cutoff a decade
+/// apart from the next).
+double largest_singular_value(const ColMat& r, int iterations = 20);
+/// a <- its QR's triangle (a.cols() square) and b <- the first a.cols() rows of Q^T b, unless a
+/// is upper triangular and square already (the Hadamard form's merged reduction).
+void reduce_to_triangle(ColMat& a, ColMat& b);
 
 }  // namespace hnn::nn::sampled

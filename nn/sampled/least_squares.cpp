@@ -154,9 +154,11 @@ void check_finite(const ColMat& c) {
   }
 }
 
-// dgelsd on the formed matrix (or the Hadamard form's reduction, dim times shorter): the
-// reference, at the memory of A (of D and the reduction).
-void solve_by_svd(const LinearSystem& system, double rcond, LeastSquaresResult& out) {
+// The reduced problem (the Hadamard form's: one QR of D, its triangles merged) solved at rcond:
+// dgelsd (kQr, the reference) or Tikhonov on the triangle (kRidge), at the memory of the
+// reduction.
+void solve_reduced(const LinearSystem& system, LeastSquaresSolver solver, double rcond,
+                   LeastSquaresResult& out) {
   auto start = Clock::now();
   ColMat a, b;
   system.reduced(a, b);
@@ -164,7 +166,12 @@ void solve_by_svd(const LinearSystem& system, double rcond, LeastSquaresResult& 
   out.bytes = std::size_t(a.size() + b.size()) * sizeof(double);
   check_columns(a.colwise().squaredNorm().transpose());  // the reduction keeps column norms
   start = Clock::now();
-  lstsq_svd(a, b, rcond);
+  if (solver == LeastSquaresSolver::kQr) {
+    lstsq_svd(a, b, rcond);
+  } else {
+    reduce_to_triangle(a, b);
+    ridge_triangle(a, b, rcond * largest_singular_value(a));
+  }
   out.c = b.topRows(system.unknowns());
   out.solve_seconds = seconds_since(start);
 }
@@ -175,8 +182,9 @@ LeastSquaresResult solve_least_squares(const LinearSystem& system, const Sampled
   const BlasThreads threads;
   LeastSquaresResult out;
   const Index p = system.unknowns();
-  if (config.solver == LeastSquaresSolver::kQr) {
-    solve_by_svd(system, config.rcond.value(), out);
+  if (config.solver != LeastSquaresSolver::kLsqr &&
+      config.solver != LeastSquaresSolver::kCholesky) {
+    solve_reduced(system, config.solver, config.rcond.value(), out);
   } else {
     auto start = Clock::now();
     ColMat g(p, p);

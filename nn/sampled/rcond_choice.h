@@ -1,9 +1,12 @@
 #pragma once
 // --rcond auto (docs/sampled.md, "Noisy data: --rcond auto"): the least-squares cutoff chosen by
 // validation. A contiguous tenth of the points is held out; the reduced problem of the other nine
-// tenths is decomposed once by an SVD, and each cutoff of a ladder (1e-14 ... 1e-1, a decade
+// tenths is decomposed once by an SVD (qr), and each cutoff of a ladder (1e-14 ... 1e-1, a decade
 // apart) gives its solution as a cheap product with the SVD's factors, judged by its field error
-// on the held-out points; more tenths in turn while fewer than kHeldOutPoints were held out. Exact
+// on the held-out points; more tenths in turn while fewer than kHeldOutPoints were held out. ridge
+// solves the fold's triangle once per cutoff instead, from the smallest, and stops where the
+// held-out error passes a hundred times the best (on exact derivatives after a few cutoffs: an
+// SVD of a 5000-wide triangle costs more than twenty such solves). Exact
 // derivatives want the smallest cutoff (the peer's 1e-13); noisy ones a large one, or the fit
 // interpolates the noise and its rollouts run away.
 
@@ -36,10 +39,10 @@ std::vector<PointSplit> validation_folds(Eigen::Index points);
 /// Builds the last layer's system on the given points (indices into the fit's data).
 using SystemOn = std::function<std::unique_ptr<LinearSystem>(const std::vector<Eigen::Index>&)>;
 
-/// The cutoff of rcond_ladder() whose fits on each fold's training points have the smallest
-/// relative field error over the held-out points of every fold (ties to the smaller cutoff), and
-/// every cutoff's error in `curve`.
+/// The cutoff of rcond_ladder() whose fits by `solver` (qr or ridge) on each fold's training
+/// points have the smallest relative field error over the held-out points of every fold (ties to
+/// the smaller cutoff), and every cutoff's error in `curve` (ridge: those its walk reached).
 double choose_rcond(const SystemOn& system_on, const std::vector<PointSplit>& folds,
-                    std::vector<RcondTrial>& curve);
+                    LeastSquaresSolver solver, std::vector<RcondTrial>& curve);
 
 }  // namespace hnn::nn::sampled

@@ -124,15 +124,15 @@ Fitted fit_once(const DynamicsConfig& mc, const ColMat& x, const ColMat& dxdt,
   fit.layers = sample_hidden(mc, x, sampler, target, rng, keep_last ? &fit.last_hidden : nullptr);
   report.sample_seconds += seconds_from(start);
   SampledFitConfig solve = config;
-  if (config.solver == LeastSquaresSolver::kQr && !config.rcond) {
+  if (reads_rcond(config.solver) && !config.rcond) {
     start = Clock::now();
     const auto on = [&](const std::vector<Index>& rows) {
       const ColMat hidden =
           mc.model == ModelKind::kBaseline ? ColMat(fit.last_hidden(rows, Eigen::all)) : ColMat();
       return last_layer_system(mc, fit.layers, hidden, x(rows, Eigen::all), dxdt(rows, Eigen::all));
     };
-    solve.rcond =
-        sampled::choose_rcond(on, sampled::validation_folds(x.rows()), report.rcond_validation);
+    solve.rcond = sampled::choose_rcond(on, sampled::validation_folds(x.rows()), config.solver,
+                                        report.rcond_validation);
     report.validation_seconds += seconds_from(start);
   }
   report.rcond = solve.rcond.value_or(0);

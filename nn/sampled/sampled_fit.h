@@ -36,22 +36,33 @@ enum class LeastSquaresSolver {
   kCholesky,  // the regularised normal equations (A^T A + lambda I) c = A^T b, by Cholesky
   kQr,        // LAPACK's dgelsd (SVD-based, like np.linalg.lstsq) on A, or for one hidden layer
               // on its reduction by a QR of D (docs/sampled.md)
+  kRidge,     // qr's reduction, then Tikhonov on its triangle R: the QR of [R; mu I] by dtpqrt,
+              // mu = rcond times R's largest singular value, and one triangular solve
 };
-inline constexpr NameTable<LeastSquaresSolver, 3> kLeastSquaresSolverNames{{
+inline constexpr NameTable<LeastSquaresSolver, 4> kLeastSquaresSolverNames{{
     {LeastSquaresSolver::kLsqr, "lsqr"},
     {LeastSquaresSolver::kCholesky, "cholesky"},
     {LeastSquaresSolver::kQr, "qr"},
+    {LeastSquaresSolver::kRidge, "ridge"},
 }};
+
+/// Whether a solver reads SampledFitConfig::rcond (the others read regularization, and lsqr
+/// tolerance and max_iterations).
+constexpr bool reads_rcond(LeastSquaresSolver solver) {
+  return solver != LeastSquaresSolver::kLsqr && solver != LeastSquaresSolver::kCholesky;
+}
 
 /// Settings of a sampled fit. The defaults reproduce the peer's accuracy (docs/sampled.md).
 struct SampledFitConfig {
   HiddenSampler sampler = HiddenSampler::kUswim;
-  /// kQr: singular values below rcond times the largest do not shape the solution (the peer's
-  /// np.linalg.lstsq rcond). Empty (auto, the default): chosen by validation on held-out tenths
-  /// of the points, then the fit runs again on all of them at that cutoff (rcond_choice.h).
+  /// kQr, kRidge: singular values below rcond times the largest do not shape the solution (the
+  /// peer's np.linalg.lstsq rcond; kQr drops them, kRidge damps them). Empty (auto, the default):
+  /// chosen by validation on held-out tenths of the points, then the fit runs again on all of them
+  /// at that cutoff (rcond_choice.h).
   std::optional<double> rcond{};
   std::uint64_t seed = 0;
-  /// kQr by default: the only solver that keeps the peer's accuracy (docs/sampled.md).
+  /// kQr by default: it keeps the peer's accuracy; so does kRidge in a twentieth of the solve's
+  /// time on exact derivatives, but it chose other cutoffs on noisy data (docs/sampled.md).
   LeastSquaresSolver solver = LeastSquaresSolver::kQr;
   /// lambda, added to the diagonal of A^T A after its columns are scaled to unit norm, for
   /// kCholesky and kLsqr's preconditioner. When the Cholesky factorisation fails, lambda is
@@ -85,7 +96,7 @@ struct SampledFitReport {
   std::size_t matrix_bytes = 0;  // the largest matrices held at once
   double residual_rms = 0;       // root mean square of the system's residual on the fit data
   int iterations = 0;            // of an iterative solver; 0 for a direct one
-  double rcond = 0;              // kQr: the cutoff the solve used (auto: the one chosen)
+  double rcond = 0;              // kQr, kRidge: the cutoff used (auto: the one chosen)
   std::vector<RcondTrial> rcond_validation;  // auto: every cutoff tried (the last fit's)
   double validation_seconds = 0;             // auto: choosing the cutoff (not in the others)
 };

@@ -43,6 +43,28 @@ void check_sampled_options(const RunOptions& o) {
                   name);
 }
 
+void check_solver_options(const FitConfig& fit, const nlohmann::json& settings,
+                          const std::string& task) {
+  using nn::LeastSquaresSolver;
+  const LeastSquaresSolver solver = fit.sampled.solver;
+  const bool lsqr = solver == LeastSquaresSolver::kLsqr;
+  struct SolverOption {
+    const char* key;
+    bool read;  // by this solver
+    const char* readers;
+  };
+  const SolverOption options[] = {
+      {"rcond", nn::reads_rcond(solver), "qr and ridge"},
+      {"regularization", lsqr || solver == LeastSquaresSolver::kCholesky, "lsqr and cholesky"},
+      {"solver_tolerance", lsqr, "lsqr"},
+      {"solver_iterations", lsqr, "lsqr"}};
+  for (const SolverOption& o : options) {
+    HNN_TASKS_CHECK(
+        o.read || !settings.contains(o.key), "{}: --{} does not apply to --solver {} (read by {})",
+        task, fit_option_name(o.key), nn::name_of(nn::kLeastSquaresSolverNames, solver), o.readers);
+  }
+}
+
 nlohmann::json recorded_fit(const fs::path& run_dir) {
   const RunFolder folder(run_dir);
   std::error_code ec;

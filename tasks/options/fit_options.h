@@ -21,6 +21,12 @@ const char* adam_option_given(const RunOptions& o);
 /// sampled, which takes none.
 void check_sampled_options(const RunOptions& o);
 
+/// Throws Error, naming `task`, for a solver option in `settings` (the run's task_settings) that
+/// `fit`'s least-squares solver does not read: --rcond but for qr and ridge; --regularization
+/// but for lsqr and cholesky; --solver-tolerance and --solver-iterations but for lsqr.
+void check_solver_options(const FitConfig& fit, const nlohmann::json& settings,
+                          const std::string& task);
+
 /// metrics.json's "fit" in `run_dir` (how its weights were sampled and solved), or, before its
 /// metrics.json, the one its checkpoint carries; null for a run of Adam alone, or no run. What a
 /// run evaluated again, resumed or continued with Adam (which does not sample again) keeps.

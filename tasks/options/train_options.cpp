@@ -313,8 +313,9 @@ const TrainOption kOptions[] = {
      .noun = "sampler"},
     {.name = "rcond",
      .kind = ValueKind::kAutoOrFraction,
-     .help = "qr's least-squares cutoff: singular values below rcond times the largest do not "
-             "shape the last layer, a number in (0, 1) (the peer's 1e-13 suits exact dx/dt), or "
+     .help = "qr's and ridge's least-squares cutoff: singular values below rcond times the "
+             "largest do not shape the last layer (qr drops them, ridge damps them), a number in "
+             "(0, 1) (the peer's 1e-13 suits exact dx/dt), or "
              "auto: the cutoff of 1e-14 ... 1e-1 with the smallest field error on a held-out "
              "tenth of the points, then refitted on all (default auto)",
      .group = kFitGroup,
@@ -324,8 +325,8 @@ const TrainOption kOptions[] = {
     {.name = "solver",
      .kind = ValueKind::kChoice,
      .help = "The last layer's least-squares solver: lsqr (preconditioned iterations), cholesky "
-             "(regularised normal equations) or qr (LAPACK's dgelsd, like numpy's lstsq) (default "
-             "qr)",
+             "(regularised normal equations), qr (LAPACK's dgelsd, like numpy's lstsq) or ridge "
+             "(qr's reduction, then Tikhonov at rcond on its triangle) (default qr)",
      .group = kFitGroup,
      .sweep_rank = 29,
      .applies_to = AppliesTo::kFieldTasks,

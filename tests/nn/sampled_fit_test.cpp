@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <random>
@@ -34,6 +35,14 @@ Problem pendulum(int n, std::uint64_t seed, double damping = 0) {
     out.dxdt(i, 1) = -std::sin(out.x(i, 0)) - damping * out.x(i, 1);
   }
   return out;
+}
+
+// `data` with Gaussian noise of standard deviation `sigma` added to its dx/dt.
+Problem with_noise(Problem data, double sigma, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> noise(0, sigma);
+  for (Index i = 0; i < data.dxdt.size(); ++i) data.dxdt.data()[i] += noise(rng);
+  return data;
 }
 
 DynamicsConfig model_config(ModelKind kind, std::vector<Index> hidden) {
@@ -79,12 +88,13 @@ std::unique_ptr<DynamicsModel<double>> pendulum_hnn(const SampledFitConfig& fit)
 
 // Relative L2 errors on held-out points (a width-100 HNN on 300 points reaches about 2e-3 in
 // the field, like the peer's numpy U-SWIM on the same data); LSQR reproduces dgelsd's solution,
-// the regularised normal equations fall short of it.
+// the regularised normal equations fall short of it; ridge (Tikhonov at mu = rcond sigma_max)
+// is as close to it.
 TEST(SampledFit, HnnMatchesThePendulumFieldAndEnergy) {
   const Problem test = pendulum(200, 3);
   std::vector<double> errors;
-  for (LeastSquaresSolver solver :
-       {LeastSquaresSolver::kQr, LeastSquaresSolver::kLsqr, LeastSquaresSolver::kCholesky}) {
+  for (LeastSquaresSolver solver : {LeastSquaresSolver::kQr, LeastSquaresSolver::kLsqr,
+                                    LeastSquaresSolver::kCholesky, LeastSquaresSolver::kRidge}) {
     auto model = pendulum_hnn({.rcond = 1e-13, .solver = solver});  // the peer's cutoff
     errors.push_back(field_error(*model, test));
     EXPECT_LT(errors.back(), 3e-2) << name_of(kLeastSquaresSolverNames, solver);
@@ -92,6 +102,7 @@ TEST(SampledFit, HnnMatchesThePendulumFieldAndEnergy) {
   }
   EXPECT_LT(errors[0], 1e-2);
   EXPECT_NEAR(errors[1], errors[0], 1e-2 * errors[0]);
+  EXPECT_NEAR(errors[3], errors[0], 0.2 * errors[0]);
 }
 
 TEST(SampledFit, EverySamplerFits) {
@@ -188,8 +199,8 @@ TEST(SampledFit, SingularSystemIsRefused) {
   std::mt19937_64 rng(1);
   auto model = make_model<double>(relu, rng);
   const Matrix<double> before = model->mlp().layers()[1].weight().value();
-  for (LeastSquaresSolver solver :
-       {LeastSquaresSolver::kQr, LeastSquaresSolver::kLsqr, LeastSquaresSolver::kCholesky}) {
+  for (LeastSquaresSolver solver : {LeastSquaresSolver::kQr, LeastSquaresSolver::kLsqr,
+                                    LeastSquaresSolver::kCholesky, LeastSquaresSolver::kRidge}) {
     try {
       fit_sampled(*model, same.x, same.dxdt, {.sampler = HiddenSampler::kElm, .solver = solver});
       ADD_FAILURE() << "a singular system was solved";
@@ -205,10 +216,7 @@ TEST(SampledFit, SingularSystemIsRefused) {
 // interpolates the noise, and a large cutoff wins.
 TEST(SampledFit, AutoRcondIsLargeOnNoisyDataAndSmallOnExactData) {
   const Problem exact = pendulum(300, 2);
-  Problem noisy = exact;
-  std::mt19937_64 rng(5);
-  std::normal_distribution<double> noise(0, 0.1);
-  for (Index i = 0; i < noisy.dxdt.size(); ++i) noisy.dxdt.data()[i] += noise(rng);
+  const Problem noisy = with_noise(exact, 0.1, 5);
   const auto chosen = [](const Problem& data) {
     std::mt19937_64 init(1);
     auto model = make_model<double>(model_config(ModelKind::kHnn, {100}), init);
@@ -229,14 +237,41 @@ TEST(SampledFit, AutoRcondIsLargeOnNoisyDataAndSmallOnExactData) {
   EXPECT_GT(on_noisy.validation_seconds, 0);
 }
 
+// ridge's auto walks the ladder from the smallest cutoff and stops where the held-out error
+// passes a hundred times the best: on exact derivatives after a few cutoffs, on noisy ones at a
+// large cutoff; then it refits at the chosen one.
+TEST(SampledFit, RidgeAutoRcondWalksTheLadderFromTheSmallest) {
+  const Problem exact = pendulum(300, 2);
+  const Problem noisy = with_noise(exact, 0.1, 5);
+  const SampledFitConfig ridge{.solver = LeastSquaresSolver::kRidge};
+  std::mt19937_64 init(1);
+  auto on_exact = make_model<double>(model_config(ModelKind::kHnn, {100}), init);
+  auto on_noisy = make_model<double>(model_config(ModelKind::kHnn, {100}), init);
+  auto refit = make_model<double>(model_config(ModelKind::kHnn, {100}), init);
+  const SampledFitReport exact_report = fit_sampled(*on_exact, exact.x, exact.dxdt, ridge);
+  const SampledFitReport noisy_report = fit_sampled(*on_noisy, noisy.x, noisy.dxdt, ridge);
+  EXPECT_LE(exact_report.rcond, 1e-9);
+  EXPECT_GE(noisy_report.rcond, 1e-5);
+  const std::vector<RcondTrial>& walked = exact_report.rcond_validation;
+  ASSERT_GE(walked.size(), 2u);
+  EXPECT_LT(walked.size(), 14u);  // stopped early
+  EXPECT_DOUBLE_EQ(walked.front().rcond, 1e-14);
+  double best = walked.front().error;
+  for (std::size_t i = 0; i + 1 < walked.size(); ++i) {
+    best = std::min(best, walked[i].error);
+    EXPECT_LE(walked[i].error, 100 * best);  // the walk went on
+  }
+  EXPECT_GT(walked.back().error, 100 * best);  // and stopped there
+  fit_sampled(*refit, noisy.x, noisy.dxdt, {.rcond = noisy_report.rcond, .solver = ridge.solver});
+  EXPECT_EQ(refit->mlp().layers()[1].weight().value(),
+            on_noisy->mlp().layers()[1].weight().value());
+}
+
 // After the choice the fit runs again on every point at the chosen cutoff: the same weights as
 // an explicit --rcond of that value (the hidden layers' draws do not see the split); the
 // baseline (several outputs, a formed matrix) alike.
 TEST(SampledFit, AutoRcondRefitsOnEveryPointAtTheChosenCutoff) {
-  Problem data = pendulum(300, 2);
-  std::mt19937_64 rng(7);
-  std::normal_distribution<double> noise(0, 0.05);
-  for (Index i = 0; i < data.dxdt.size(); ++i) data.dxdt.data()[i] += noise(rng);
+  const Problem data = with_noise(pendulum(300, 2), 0.05, 7);
   for (ModelKind kind : {ModelKind::kHnn, ModelKind::kBaseline}) {
     std::mt19937_64 init(1);
     auto automatic = make_model<double>(model_config(kind, {60}), init);

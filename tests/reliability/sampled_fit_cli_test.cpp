@@ -6,6 +6,8 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <array>
+
 #include "nn/sampled/sampled_fit.h"
 #include "reliability_util.h"
 #include "tasks/options/fit_options.h"
@@ -71,7 +73,7 @@ std::vector<BadOption> bad_fit_options() {
       {{"train", "spring", "--fit", "sampled", "--sampler", "gauss"},
        "--sampler: gauss not in {elm,uswim,aswim}"},
       {{"train", "spring", "--fit", "sampled", "--solver", "svd"},
-       "--solver: svd not in {lsqr,cholesky,qr}"},
+       "--solver: svd not in {lsqr,cholesky,qr,ridge}"},
       {{"train", "spring", "--fit", "sampled", "--rcond", "1"},
        "--rcond: expected auto or a number in (0, 1), got '1'"},
       {{"train", "spring", "--fit", "sampled", "--rcond", "often"},
@@ -86,6 +88,24 @@ std::vector<BadOption> bad_fit_options() {
        "--solver-iterations: Value 0 not in range 1 to 100000"},
   };
   bad.insert(bad.end(), others.begin(), others.end());
+  // A solver option the solver does not read (tasks/options/fit_options.h); qr by default.
+  for (const auto& [solver, option, value, readers] : std::vector<std::array<std::string, 4>>{
+           {"lsqr", "--rcond", "1e-10", "qr and ridge"},
+           {"cholesky", "--rcond", "1e-10", "qr and ridge"},
+           {"qr", "--regularization", "1e-8", "lsqr and cholesky"},
+           {"ridge", "--regularization", "1e-8", "lsqr and cholesky"},
+           {"qr", "--solver-tolerance", "1e-8", "lsqr"},
+           {"cholesky", "--solver-tolerance", "1e-8", "lsqr"},
+           {"qr", "--solver-iterations", "50", "lsqr"},
+           {"ridge", "--solver-iterations", "50", "lsqr"}}) {
+    bad.push_back({{"train", "spring", "--fit", "sampled", "--solver", solver, option, value},
+                   "spring: " + option + " does not apply to --solver " + solver + " (read by " +
+                       readers + ")"});
+  }
+  bad.push_back(
+      {{"train", "spring", "--fit", "sampled+adam", "--steps", "2", "--regularization", "0.01"},
+       "spring: --regularization does not apply to --solver qr (read by lsqr and "
+       "cholesky)"});
   return bad;
 }
 
