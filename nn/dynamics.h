@@ -74,9 +74,14 @@ struct DynamicsConfig {
   /// many states, and the loss there is enormous); the MLP learns the rest, and can cancel
   /// the term. 0: Cranmer et al.'s plain L = MLP.
   double kinetic_prior = 1.0;
+  /// Baseline only: the state is (q, v = dq/dt) and the MLP outputs dv/dt alone, dq/dt = v being
+  /// given, as the LNN paper's baseline does (Cranmer et al. 2020, their baseline_eom in
+  /// notebooks/DoublePendulum-Baseline.ipynb). False: the MLP outputs all of dx/dt.
+  bool given_velocities = false;
 };
 
-/// The MLP of a model: dim -> hidden... -> out, with out = dim for the baseline, the number of
+/// The MLP of a model: dim -> hidden... -> out, with out = dim for the baseline (dim / 2 with
+/// given_velocities), the number of
 /// learned scalars for an HNN (1, or 2 for kBoth: column 0 is H, column 1 is D), 1 (L) for an LNN.
 MlpConfig mlp_config(const DynamicsConfig& config);
 /// Throws std::invalid_argument when the config cannot make a model (odd HNN dim, ...).
