@@ -76,6 +76,12 @@ void validate(const DynamicsConfig& config) {
     throw std::invalid_argument(
         fmt::format("model: an LNN needs an even state dimension x = (q, v), got {}", config.dim));
   }
+  if (config.given_velocities && (config.model != ModelKind::kBaseline || config.dim % 2 != 0)) {
+    throw std::invalid_argument(fmt::format(
+        "model: given velocities need a baseline with an even state x = (q, v), got a {} of "
+        "dimension {}",
+        to_string(config.model), config.dim));
+  }
   if (!(std::isfinite(config.kinetic_prior) && config.kinetic_prior >= 0)) {
     throw std::invalid_argument(fmt::format(
         "model: kinetic_prior must be a finite number >= 0, got {}", config.kinetic_prior));
@@ -110,7 +116,7 @@ MlpConfig mlp_config(const DynamicsConfig& config) {
   // An angle is seen as (cos, sin); a constrained model's MLP sees the positions only.
   mlp.widths.push_back(is_constrained(config.model) ? config.dim / 2 : config.dim + config.angles);
   mlp.widths.insert(mlp.widths.end(), config.hidden.begin(), config.hidden.end());
-  Index out = config.dim;
+  Index out = config.given_velocities ? config.dim / 2 : config.dim;
   if (learns_scalars(config.model)) out = config.field == FieldType::kBoth ? 2 : 1;
   if (config.model == ModelKind::kLnn || is_constrained(config.model)) out = 1;
   mlp.widths.push_back(out);

@@ -92,11 +92,16 @@ struct DynamicsConfig {
   /// CHNN and CLNN only (empty for the others): the system, whose state x = (positions,
   /// velocities) has dim = 2 N d. Their MLP sees the positions only and learns V.
   ConstraintSpec constraints{};
+  /// Baseline only: the state is (q, v = dq/dt) and the MLP outputs dv/dt alone, dq/dt = v being
+  /// given, as the LNN paper's baseline does (Cranmer et al. 2020, their baseline_eom in
+  /// notebooks/DoublePendulum-Baseline.ipynb). False: the MLP outputs all of dx/dt.
+  bool given_velocities = false;
 };
 
-/// The MLP of a model: dim -> hidden... -> out, with out = dim for the baseline, the number of
-/// learned scalars for an HNN (1, or 2 for kBoth: column 0 is H, column 1 is D), 1 (L) for an LNN;
-/// N d -> hidden... -> 1 (V of the positions) for a CHNN or CLNN.
+/// The MLP of a model: dim -> hidden... -> out, with out = dim for the baseline (dim / 2 with
+/// given_velocities), the number of learned scalars for an HNN (1, or 2 for kBoth: column 0 is
+/// H, column 1 is D), 1 (L) for an LNN; N d -> hidden... -> 1 (V of the positions) for a CHNN or
+/// CLNN.
 MlpConfig mlp_config(const DynamicsConfig& config);
 /// Throws std::invalid_argument when the config cannot make a model (odd HNN dim, ...).
 void validate(const DynamicsConfig& config);

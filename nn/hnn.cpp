@@ -130,7 +130,10 @@ Baseline<T>::Baseline(DynamicsConfig config, Mlp<T> mlp)
 template <typename T>
 ad::Var<T> Baseline<T>::time_derivative(const ad::Var<T>& x) const {
   this->check_input("time_derivative", x.rows(), x.cols());
-  return this->mlp_.forward(this->mlp_input(x));
+  const ad::Var<T> out = this->mlp_.forward(this->mlp_input(x));
+  if (!this->config_.given_velocities) return out;
+  const Index n = this->dim() / 2;  // dq/dt = v, the state's second half; the MLP gives dv/dt
+  return ad::concat_cols<T>({ad::slice_cols(x, n, n), out});
 }
 
 template <typename T>
@@ -138,7 +141,7 @@ Matrix<T> Baseline<T>::field(const MatrixView<T>& x) const {
   this->check_input("field", x.rows(), x.cols());
   ad::TapeScope scope;
   ad::NoGradGuard values_only;
-  return this->mlp_.forward(this->mlp_input(ad::Var<T>::constant(x))).value();
+  return time_derivative(ad::Var<T>::constant(x)).value();
 }
 
 // ---- factory ------------------------------------------------------------------------------

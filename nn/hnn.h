@@ -47,7 +47,8 @@ class Hnn : public DynamicsModel<T> {
   }
 };
 
-/// The paper's baseline: an MLP dim -> hidden... -> dim that outputs dx/dt directly.
+/// The paper's baseline: an MLP dim -> hidden... -> dim that outputs dx/dt directly (or dv/dt
+/// alone, with DynamicsConfig::given_velocities).
 template <typename T>
 class Baseline : public DynamicsModel<T> {
  public:

@@ -13,10 +13,12 @@
 
 namespace hnn::tasks {
 
-/// How the models see their inputs (angle coordinates, input scales), as the task says.
+/// How the models see their inputs (angle coordinates, input scales), as the task says, and
+/// whether a baseline is given its velocities (tasks/options/baseline_output.h).
 struct ModelInput {
   Eigen::Index angles = 0;
   std::vector<double> input_scale{};
+  bool given_velocities = false;
 };
 
 class FieldModelRun : public TaskRun {
@@ -62,7 +64,8 @@ class FieldModelRun : public TaskRun {
     nn::DynamicsConfig config{.model = s_.model,
                               .dim = data_.train_x.cols(),
                               .angles = input_.angles,
-                              .input_scale = input_.input_scale};
+                              .input_scale = input_.input_scale,
+                              .given_velocities = input_.given_velocities};
     if (s_.model == nn::ModelKind::kDhnn) config.field = nn::FieldType::kBoth;
     config.hidden.assign(s_.train.hidden.begin(), s_.train.hidden.end());
     try {

@@ -14,6 +14,7 @@
 #include "tasks/evaluate/field_evaluation.h"
 #include "tasks/evaluate/held_out.h"
 #include "tasks/field/field_model_run.h"
+#include "tasks/options/baseline_output.h"
 #include "tasks/report/json_values.h"
 #include "tasks/report/rollout_csv.h"
 
@@ -23,11 +24,17 @@ namespace {
 
 using nlohmann::json;
 
+ModelInput model_input(const FieldTask& task, const RunSettings& s) {
+  return {.angles = task.angle_coordinates(),
+          .input_scale = task.input_scale(),
+          .given_velocities = given_velocities(s.task_settings, s.model, s.fit.samples(),
+                                               velocity_state(task), task.name())};
+}
+
 class FieldRun : public FieldModelRun {
  public:
   FieldRun(const FieldTask& task, RunSettings settings)
-      : FieldModelRun(settings, task.build_dataset(settings),
-                      {.angles = task.angle_coordinates(), .input_scale = task.input_scale()}),
+      : FieldModelRun(settings, task.build_dataset(settings), model_input(task, settings)),
         task_(task),
         own_truth_(task.truth_for(s_)) {
     const RolloutLossConfig& loss = s_.loss;
@@ -241,6 +248,7 @@ std::optional<SplitStretches> FieldTask::stretches(const RunSettings&, const Dat
 void FieldTask::check_task_settings(const nlohmann::json& settings) const {
   const std::vector<std::string> own = own_setting_names(), rollouts = evaluation_setting_names();
   std::vector<std::string> known = rollout_setting_names();
+  known.push_back(kBaselineOutputKey);
   known.insert(known.end(), fit_setting_names().begin(), fit_setting_names().end());
   known.insert(known.end(), own.begin(), own.end());
   known.insert(known.end(), rollouts.begin(), rollouts.end());

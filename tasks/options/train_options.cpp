@@ -11,6 +11,7 @@
 #include "tasks/data/measured_dataset.h"
 #include "tasks/error.h"
 #include "tasks/integrate/integrator_step.h"
+#include "tasks/options/baseline_output.h"
 
 namespace hnn::tasks {
 
@@ -358,6 +359,16 @@ const TrainOption kOptions[] = {
      .min = 1,
      .max = 100000,
      .range_in_help = true},
+    {.name = "baseline-output",
+     .kind = ValueKind::kChoice,
+     .help = "What the baseline's MLP gives: field (all of dx/dt, the default) or accelerations "
+             "(dv/dt alone, dq/dt = v given, as the LNN paper's baseline; tasks whose state is "
+             "(q, dq/dt): double-pendulum, real-double-pendulum)",
+     .sweep_rank = 33,
+     .applies_to = AppliesTo::kFieldTasks,
+     .key = "baseline_output",
+     .choices = baseline_output_names,
+     .noun = "baseline output"},
 };
 
 }  // namespace

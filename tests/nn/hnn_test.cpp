@@ -271,6 +271,27 @@ TEST(Baseline, PredictsTheFieldDirectlyWithTheSameInterface) {
   EXPECT_TRUE(r.ok) << r.worst << "\n" << r.log;
 }
 
+TEST(Baseline, GivenVelocitiesPredictsTheAccelerationsAlone) {
+  std::mt19937_64 rng(23);
+  nn::DynamicsConfig config = small_config(ModelKind::kBaseline, 4, {8, 8});
+  config.given_velocities = true;
+  const auto model = nn::make_model<double>(config, rng);
+  EXPECT_EQ(model->mlp().output_dim(), 2);
+  const MatrixD x = random_states(5, 4, 24);
+  const MatrixD f = model->field(x);
+  EXPECT_EQ(f.leftCols(2), x.rightCols(2));  // dq/dt = v, given
+  ad::TapeScope scope;
+  EXPECT_EQ(f.rightCols(2), model->mlp().forward(Var<double>::constant(x)).value());
+  const ad::CheckResult r =
+      ad::gradcheck(loss_of(*model, random_states(5, 4, 25)), inputs_of(*model, x));
+  EXPECT_TRUE(r.ok) << r.worst << "\n" << r.log;
+  config.dim = 3;
+  EXPECT_THROW(nn::make_model<double>(config, rng), std::invalid_argument);
+  config.dim = 4;
+  config.model = ModelKind::kLnn;
+  EXPECT_THROW(nn::make_model<double>(config, rng), std::invalid_argument);
+}
+
 TEST(Models, CastBetweenFloatAndDoubleKeepsPredictions) {
   std::mt19937_64 rng(22);
   const auto model = nn::make_model<double>(small_config(ModelKind::kHnn, 2, {16, 16}), rng);

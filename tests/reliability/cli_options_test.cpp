@@ -55,8 +55,9 @@ std::vector<BadOption> bad_train_options() {
        "task 'spring' does not read a data file (--data applies to measured-data tasks such as "
        "real-pendulum)"},
       {{"train", "spring", "--settings", "{\"trials\": 20}"},
-       "task 'spring' has no setting 'trials' (known: loss, horizon, integrator, dt, fit, "
-       "sampler, rcond, solver, regularization, solver_tolerance, solver_iterations, sample_dt, "
+       "task 'spring' has no setting 'trials' (known: loss, horizon, integrator, dt, "
+       "baseline_output, fit, sampler, rcond, solver, regularization, solver_tolerance, "
+       "solver_iterations, sample_dt, "
        "t_end, rollouts, rollout_t_end)"},
       {{"train", "two-body", "--settings", "{\"rollouts\": 0}"},
        "two-body: rollouts must be an integer from 1 to 1000, got 0"},
@@ -260,7 +261,8 @@ TEST(TrainOptionsTable, TheSweepKeysAreItsRowsInRankOrderAndTheOthersAreRefusedW
       "trajectory": "traj", "split": "time", "test-fraction": 0.3, "hamiltonian": "q^2",
       "loss": "rollout", "horizon": 2, "integrator": "leapfrog", "dt": 0.05,
       "fit": "sampled+adam", "sampler": "aswim", "rcond": 1e-10, "solver": "qr",
-      "regularization": 1e-9, "solver-tolerance": 1e-10, "solver-iterations": 50})");
+      "regularization": 1e-9, "solver-tolerance": 1e-10, "solver-iterations": 50,
+      "baseline-output": "field"})");
   json spec = json::object();
   std::vector<const TrainOption*> keys;
   for (const TrainOption& option : tasks::train_options()) {

@@ -1,6 +1,6 @@
 // The Lagrangian NN as a model the program trains (--model lnn) on the double-pendulum task of
 // its paper, in angles and angular velocities: short runs that learn, its energy metric, and the
-// models and settings the task refuses.
+// models and settings the task refuses; its baseline on accelerations alone (--baseline-output).
 
 #include <gtest/gtest.h>
 
@@ -60,6 +60,31 @@ TEST(DoublePendulumTask, RefusesModelsThatNeedMomentaAndUnknownSettings) {
   EXPECT_THROW(run_training(o), Error);
   o.task_settings = {{"rollouts", 0}};
   EXPECT_THROW(run_training(o), Error);
+}
+
+TEST(DoublePendulumTask, TrainsABaselineOnAccelerationsAloneAndRefusesItElsewhere) {
+  TempDir dir("runs");
+  RunOptions o = testing::small_run("double-pendulum", "baseline", dir / "acc", 20);
+  o.task_settings = {{"rollouts", 2}, {"t_end", 1.0}, {"baseline_output", "accelerations"}};
+  const nlohmann::json m = run_training(o);
+  EXPECT_TRUE(std::isfinite(m["test_loss"].get<double>())) << m.dump();
+  // Its run loads with the same shape of MLP (4 outputs would not fit its 2).
+  EXPECT_EQ(evaluate_run(dir / "acc", "", false)["test_loss"], m["test_loss"]);
+  const auto refused = [&](const std::string& task, const std::string& model,
+                           const std::string& value, const std::string& why) {
+    RunOptions bad = testing::small_run(task, model, dir / "bad", 5);
+    bad.task_settings = {{"baseline_output", value}};
+    try {
+      run_training(bad);
+      ADD_FAILURE() << task << " " << model << " " << value << " accepted";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(why), std::string::npos) << e.what();
+    }
+    EXPECT_FALSE(std::filesystem::exists(dir / "bad"));
+  };
+  refused("double-pendulum", "lnn", "accelerations", "applies to --model baseline only");
+  refused("spring", "baseline", "accelerations", "needs a state (q, dq/dt)");
+  refused("double-pendulum", "baseline", "forces", "must be field or accelerations");
 }
 
 }  // namespace
