@@ -27,44 +27,44 @@ namespace {
 namespace pc = physics::constrained;
 using nlohmann::json;
 
-constexpr int kChunk = 5;         // the peer's chunk_len
-constexpr int kTrain = 800;       // the peer's n_train
-constexpr int kValidation = 100;  // the peer's n_val: the test split of the loss curve
-constexpr int kBatch = 200, kEpochs = 2000;
-constexpr int kMaxTrajectories = 100'000;
+constexpr int kChunkOutputs = 5;              // the peer's chunk_len
+constexpr int kTrainTrajectories = 800;       // the peer's n_train
+constexpr int kValidationTrajectories = 100;  // the peer's n_val: the test split of the loss curve
+constexpr int kPeerBatch = 200, kPeerEpochs = 2000;
+constexpr int kMaxChunkedTrajectories = 100'000;
 // The floor's perturbation draws: one fixed generator, so that every model of a run's seed is
 // measured against the same floor (the starts depend on the seed).
-constexpr std::uint64_t kFloorSeed = 0x5eed;
+constexpr std::uint64_t kConstrainedFloorSeed = 0x5eed;
 
 // The state a model learns: the system's own, or the chain's angles with canonical momenta
 // (HNN) or angular velocities (LNN).
 enum class Coordinates { kCartesian, kAngles, kAngleVelocities };
 
-Coordinates coordinates_of(nn::ModelKind model) {
+Coordinates model_coordinates(nn::ModelKind model) {
   if (model == nn::ModelKind::kHnn) return Coordinates::kAngles;
   if (model == nn::ModelKind::kLnn) return Coordinates::kAngleVelocities;
   return Coordinates::kCartesian;
 }
 
-struct Entry {
+struct ConstrainedEntry {
   const char* task;
   const char* system;  // physics/constrained/systems.h
   int links;           // 0: not a chain (no angle twin)
   const char* summary;
 };
 
-int positive_setting(const json& s, const char* key, int fallback, const std::string& task) {
+int trajectory_count(const json& s, const char* key, int fallback, const std::string& task) {
   if (!s.contains(key)) return fallback;
   HNN_TASKS_CHECK(s[key].is_number_integer() && s[key].get<long>() >= 1 &&
-                      s[key].get<long>() <= kMaxTrajectories,
-                  "{}: {} must be an integer in 1..{}, got {}", task, key, kMaxTrajectories,
+                      s[key].get<long>() <= kMaxChunkedTrajectories,
+                  "{}: {} must be an integer in 1..{}, got {}", task, key, kMaxChunkedTrajectories,
                   s[key].dump());
   return s[key].get<int>();
 }
 
 class ConstrainedTask : public FieldTask {
  public:
-  ConstrainedTask(const Entry& entry, Coordinates coordinates)
+  ConstrainedTask(const ConstrainedEntry& entry, Coordinates coordinates)
       : entry_(entry),
         coordinates_(coordinates),
         cartesian_(pc::make_constrained_system(entry.system)) {
@@ -82,8 +82,8 @@ class ConstrainedTask : public FieldTask {
   std::string name() const override { return entry_.task; }
   std::string summary() const override { return entry_.summary; }
   TrainConfig train_config() const override {
-    return {.steps = kEpochs * kTrain / kBatch,
-            .batch_size = kBatch,
+    return {.steps = kPeerEpochs * kTrainTrajectories / kPeerBatch,
+            .batch_size = kPeerBatch,
             .learning_rate = 3e-3,
             .weight_decay = 1e-4,
             .lr_schedule = LrSchedule::kCosine,
@@ -91,7 +91,7 @@ class ConstrainedTask : public FieldTask {
   }
   RolloutLossConfig default_loss() const override {
     return {.rollout = true,
-            .horizon = kChunk - 1,
+            .horizon = kChunkOutputs - 1,
             .integrator = RolloutIntegrator::kRk4,
             .norm = RolloutNorm::kL1};
   }
@@ -120,7 +120,7 @@ class ConstrainedTask : public FieldTask {
   }
 
   std::unique_ptr<TaskRun> open(const RunSettings& settings) const override {
-    const Coordinates c = coordinates_of(settings.model);
+    const Coordinates c = model_coordinates(settings.model);
     if (c == coordinates_ || entry_.links == 0) return FieldTask::open(settings);
     const ConstrainedTask& twin = c == Coordinates::kAngles ? *angle_twin_ : *velocity_twin_;
     return twin.FieldTask::open(settings);
@@ -133,11 +133,13 @@ class ConstrainedTask : public FieldTask {
   }
 
   Dataset build_dataset(const RunSettings& settings) const override {
-    const int train = positive_setting(settings.task_settings, "trajectories", kTrain, name());
-    const int test = positive_setting(settings.task_settings, "validation", kValidation, name());
+    const int train =
+        trajectory_count(settings.task_settings, "trajectories", kTrainTrajectories, name());
+    const int test =
+        trajectory_count(settings.task_settings, "validation", kValidationTrajectories, name());
     std::mt19937_64 rng(settings.seed);
-    const Batch train_x = chunk_rows(pc::sample_chunks(cartesian_, train, kChunk, rng));
-    const Batch test_x = chunk_rows(pc::sample_chunks(cartesian_, test, kChunk, rng));
+    const Batch train_x = chunk_rows(pc::sample_chunks(cartesian_, train, kChunkOutputs, rng));
+    const Batch test_x = chunk_rows(pc::sample_chunks(cartesian_, test, kChunkOutputs, rng));
     Batch train_dxdt, test_dxdt;
     truth().vector_field(train_x, train_dxdt);
     truth().vector_field(test_x, test_dxdt);
@@ -145,14 +147,14 @@ class ConstrainedTask : public FieldTask {
   }
 
   std::optional<SplitStretches> stretches(const RunSettings&, const Dataset& data) const override {
-    const double span = (kChunk - 1) * cartesian_.spec().dt;
-    return SplitStretches{regular_stretches(data.train_x, kChunk, span),
-                          regular_stretches(data.test_x, kChunk, span)};
+    const double span = (kChunkOutputs - 1) * cartesian_.spec().dt;
+    return SplitStretches{regular_stretches(data.train_x, kChunkOutputs, span),
+                          regular_stretches(data.test_x, kChunkOutputs, span)};
   }
 
   // The peer's test starts: the first states of random chunks of sampled trajectories.
   Batch rollout_states(const Dataset&, int count, std::mt19937_64& rng) const override {
-    pc::ChunkSample sample = pc::sample_chunks(cartesian_, count, kChunk, rng);
+    pc::ChunkSample sample = pc::sample_chunks(cartesian_, count, kChunkOutputs, rng);
     sample.states.resize(1);
     return in_coordinates(std::move(sample.states)).front();
   }
@@ -183,7 +185,7 @@ class ConstrainedTask : public FieldTask {
     metrics["cartesian_error_failed"] = score.failed;
     metrics["cartesian_error_rollouts"] = int(z0.rows());
     if (r.t.size() == cartesian_.output_times().size()) {
-      std::mt19937_64 rng(kFloorSeed);
+      std::mt19937_64 rng(kConstrainedFloorSeed);
       metrics["cartesian_error_floor"] =
           number(pc::floor_score(cartesian_, z0, truth, rng).score.geometric_mean);
     } else {
@@ -213,13 +215,14 @@ class ConstrainedTask : public FieldTask {
     return states;
   }
 
-  // A chunk sample as rows, chunk after chunk, each chunk's kChunk states in time order.
+  // A chunk sample as rows, chunk after chunk, each chunk's kChunkOutputs states in time order.
   Batch chunk_rows(const pc::ChunkSample& sample) const {
     const std::vector<Batch> states = in_coordinates(sample.states);
     const Eigen::Index n = states.front().rows();
-    Batch rows(n * kChunk, states.front().cols());
+    Batch rows(n * kChunkOutputs, states.front().cols());
     for (Eigen::Index i = 0; i < n; ++i)
-      for (int k = 0; k < kChunk; ++k) rows.row(i * kChunk + k) = states[std::size_t(k)].row(i);
+      for (int k = 0; k < kChunkOutputs; ++k)
+        rows.row(i * kChunkOutputs + k) = states[std::size_t(k)].row(i);
     return rows;
   }
 
@@ -233,7 +236,7 @@ class ConstrainedTask : public FieldTask {
     return out;
   }
 
-  Entry entry_;
+  ConstrainedEntry entry_;
   Coordinates coordinates_;
   pc::ConstrainedSystem cartesian_;
   std::unique_ptr<pc::ChainPendulumAngles> angles_;
@@ -241,7 +244,7 @@ class ConstrainedTask : public FieldTask {
   std::unique_ptr<ConstrainedTask> angle_twin_, velocity_twin_;
 };
 
-constexpr Entry kEntries[] = {
+constexpr ConstrainedEntry kConstrainedEntries[] = {
     {"chain-pendulum-2", "chain_pendulum_2", 2,
      "2-link chain pendulum in Cartesian coordinates (Finzi et al. 2020)"},
     {"chain-pendulum-3", "chain_pendulum_3", 3,
@@ -263,12 +266,12 @@ constexpr Entry kEntries[] = {
 
 std::vector<std::string> constrained_task_names() {
   std::vector<std::string> names;
-  for (const Entry& e : kEntries) names.push_back(e.task);
+  for (const ConstrainedEntry& e : kConstrainedEntries) names.push_back(e.task);
   return names;
 }
 
 std::unique_ptr<Task> make_constrained_task(const std::string& name) {
-  for (const Entry& e : kEntries)
+  for (const ConstrainedEntry& e : kConstrainedEntries)
     if (name == e.task) return std::make_unique<ConstrainedTask>(e, Coordinates::kCartesian);
   throw Error(fmt::format("no constrained task '{}'", name));
 }

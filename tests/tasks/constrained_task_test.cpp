@@ -116,7 +116,7 @@ TEST(ConstrainedTask, RefusesAngleModelsWhereHnnHasNoAngles) {
 
 TEST(RolloutLoss, ATasksDefaultLossAndTheNormKey) {
   const RolloutLossConfig chunks{.rollout = true, .horizon = 4, .norm = RolloutNorm::kL1};
-  RolloutLossConfig c = rollout_loss_config({}, "t", chunks);
+  RolloutLossConfig c = rollout_loss_config(nlohmann::json::object(), "t", chunks);
   EXPECT_TRUE(c.rollout);
   EXPECT_EQ(c.horizon, 4);
   EXPECT_EQ(c.norm, RolloutNorm::kL1);
