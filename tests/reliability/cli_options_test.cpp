@@ -8,8 +8,8 @@
 
 #include "reliability_util.h"
 #include "tasks/experiments/registry.h"
-#include "tasks/run.h"
 #include "tasks/options/train_options.h"
+#include "tasks/run.h"
 
 namespace hnn::reliability {
 namespace {
@@ -55,7 +55,7 @@ std::vector<BadOption> bad_train_options() {
        "task 'spring' does not read a data file (--data applies to measured-data tasks such as "
        "real-pendulum)"},
       {{"train", "spring", "--settings", "{\"trials\": 20}"},
-       "task 'spring' has no setting 'trials' (known: loss, horizon, integrator, dt, fit, "
+       "task 'spring' has no setting 'trials' (known: loss, horizon, integrator, dt, norm, fit, "
        "sampler, rcond, solver, regularization, solver_tolerance, solver_iterations, sample_dt, "
        "t_end, rollouts, rollout_t_end)"},
       {{"train", "two-body", "--settings", "{\"rollouts\": 0}"},
@@ -132,7 +132,9 @@ TEST(CliOptions, BadCommandsAndOtherSubcommandsGetOneLine) {
       {{"reproduce", "--tasks", "spring,nope", "--out", (dir / "results").string()},
        "unknown task 'nope' (known: spring, pendulum, real-pendulum, two-body, three-body, "
        "pixel-pendulum, damped-spring, double-pendulum, real-double-pendulum, henon-heiles, "
-       "pendulum-scattered, double-pendulum-scattered, data)"},
+       "pendulum-scattered, double-pendulum-scattered, chain-pendulum-2, chain-pendulum-3, "
+       "chain-pendulum-4, chain-pendulum-5, coupled-pendulums, magnet-pendulum, gyroscope, rotor, "
+       "data)"},
       {{"reproduce", "--tasks", "data", "--out", (dir / "results").string()},
        "reproduce runs the paper's tasks (spring, pendulum, real-pendulum, two-body, three-body, "
        "pixel-pendulum); 'data' is not one of them: train it with hnn train data"},
@@ -190,7 +192,8 @@ TEST(CliOptions, ARunThatEndsNoBetterThanItStartedIsWarnedAbout) {
   }
 }
 
-// ---- the table of `hnn train`'s options (tasks/options/train_options.h) makes each of its forms -------
+// ---- the table of `hnn train`'s options (tasks/options/train_options.h) makes each of its forms
+// -------
 
 using nlohmann::json;
 using tasks::TrainOption;
@@ -257,7 +260,7 @@ TEST(TrainOptionsTable, TheSweepKeysAreItsRowsInRankOrderAndTheOthersAreRefusedW
       "data": "x.csv", "settings": {"threshold": 0.2}, "checkpoint-every": 2, "coords": "q",
       "momenta": "p", "velocities": "v", "derivatives": "dq,dp", "time": "t",
       "trajectory": "traj", "split": "time", "test-fraction": 0.3, "hamiltonian": "q^2",
-      "loss": "rollout", "horizon": 2, "integrator": "leapfrog", "dt": 0.05,
+      "loss": "rollout", "horizon": 2, "integrator": "leapfrog", "dt": 0.05, "norm": "l1",
       "fit": "sampled+adam", "sampler": "aswim", "rcond": 1e-10, "solver": "qr",
       "regularization": 1e-9, "solver-tolerance": 1e-10, "solver-iterations": 50})");
   json spec = json::object();
