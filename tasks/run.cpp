@@ -172,9 +172,10 @@ RunSettings resolve(const Task& task, const RunOptions& o) {
   if (std::find(models.begin(), models.end(), o.model) == models.end()) {
     std::vector<std::string_view> names;
     for (nn::ModelKind m : models) names.push_back(nn::to_string(m));
+    const std::string reason = task.refusal_reason(o.model);
     throw Error(fmt::format("task '{}' does not train a {} model (its models: {}){}", task.name(),
                             nn::to_string(o.model), fmt::join(names, ", "),
-                            needs_velocities_note(o.model)));
+                            reason.empty() ? needs_velocities_note(o.model) : reason));
   }
   const FitConfig fit = fit_config(o.task_settings, task.name());
   check_fit_model(fit, o.model, task.name());
@@ -190,7 +191,7 @@ RunSettings resolve(const Task& task, const RunOptions& o) {
                 .data_sha256 = o.data_sha256,
                 .continued_from = o.continued_from,
                 .task_settings = o.task_settings,
-                .loss = rollout_loss_config(o.task_settings, task.name()),
+                .loss = rollout_loss_config(o.task_settings, task.name(), task.default_loss()),
                 .fit = fit};
   check_train_config(s.train, s.fit);
   HNN_TASKS_CHECK(!s.loss.rollout || s.fit.steps(),

@@ -116,6 +116,12 @@ class Task {
   virtual std::vector<nn::ModelKind> models() const {
     return {nn::ModelKind::kHnn, nn::ModelKind::kBaseline, nn::ModelKind::kDhnn};
   }
+  /// Why a model kind outside models() does not fit this task, appended to the refusal ("" by
+  /// default: the list of its models says enough).
+  virtual std::string refusal_reason(nn::ModelKind) const { return ""; }
+  /// The loss a run trains with when its settings name none (tasks/train/rollout_objective.h);
+  /// by default dx/dt targets.
+  virtual RolloutLossConfig default_loss() const { return {}; }
   /// Whether --data FILE applies (tasks on measured data).
   virtual bool reads_data_file() const { return false; }
   /// Checks the task's own settings (RunSettings::task_settings); throws Error naming an unknown

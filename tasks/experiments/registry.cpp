@@ -1,15 +1,16 @@
 #include "tasks/experiments/registry.h"
 
+#include <functional>
 #include <utility>
 
 namespace hnn::tasks {
 
 namespace {
 
-using Factory = std::unique_ptr<Task> (*)();
+using Factory = std::function<std::unique_ptr<Task>()>;
 
-const std::vector<std::pair<std::string, Factory>>& registry() {
-  static const std::vector<std::pair<std::string, Factory>> tasks = {
+std::vector<std::pair<std::string, Factory>> make_registry() {
+  std::vector<std::pair<std::string, Factory>> tasks = {
       {"spring", make_spring_task},
       {"pendulum", make_pendulum_task},
       {"real-pendulum", make_real_pendulum_task},
@@ -21,8 +22,15 @@ const std::vector<std::pair<std::string, Factory>>& registry() {
       {"real-double-pendulum", make_real_double_pendulum_task},
       {"henon-heiles", make_henon_heiles_task},
       {"pendulum-scattered", make_pendulum_scattered_task},
-      {"double-pendulum-scattered", make_double_pendulum_scattered_task},
-      {"data", make_data_task}};
+      {"double-pendulum-scattered", make_double_pendulum_scattered_task}};
+  for (const std::string& name : constrained_task_names())
+    tasks.emplace_back(name, [name] { return make_constrained_task(name); });
+  tasks.emplace_back("data", make_data_task);
+  return tasks;
+}
+
+const std::vector<std::pair<std::string, Factory>>& registry() {
+  static const std::vector<std::pair<std::string, Factory>> tasks = make_registry();
   return tasks;
 }
 

@@ -16,9 +16,9 @@ namespace hnn::tasks {
 /// The tasks by name: spring, pendulum, real-pendulum, two-body, three-body, pixel-pendulum (the
 /// paper's), damped-spring (the dissipative-HNN paper's), double-pendulum (the LNN paper's),
 /// real-double-pendulum (measured), henon-heiles, pendulum-scattered and
-/// double-pendulum-scattered (the sampled-HNN paper's protocols: scattered states) and data (a
-/// user's own file). Throws Error naming the known
-/// tasks for any other name.
+/// double-pendulum-scattered (the sampled-HNN paper's protocols: scattered states), the
+/// constrained systems (constrained_task_names) and data (a user's own file). Throws Error naming
+/// the known tasks for any other name.
 std::unique_ptr<Task> make_task(const std::string& name);
 std::vector<std::string> task_names();
 /// The paper's six: what `hnn reproduce` runs by default.
@@ -43,5 +43,9 @@ std::unique_ptr<Task> make_henon_heiles_task();               // scattered.cpp
 std::unique_ptr<Task> make_pendulum_scattered_task();         // scattered.cpp
 std::unique_ptr<Task> make_double_pendulum_scattered_task();  // scattered.cpp
 std::unique_ptr<Task> make_data_task();                       // data_task.cpp
+// constrained.cpp: Finzi et al.'s constrained systems, one task each (chain-pendulum-2..5,
+// coupled-pendulums, magnet-pendulum, gyroscope, rotor).
+std::vector<std::string> constrained_task_names();
+std::unique_ptr<Task> make_constrained_task(const std::string& name);
 
 }  // namespace hnn::tasks

@@ -93,7 +93,7 @@ TrainResult FieldTraining::train_through_integrator(nn::DynamicsModel<T>& model,
                                                     const LoopOptions& loop) const {
   RolloutObjective<T> objective(model, train_windows_, test_windows_, s.train.batch_size,
                                 {.lr = s.train.learning_rate, .weight_decay = s.train.weight_decay},
-                                s.seed, loss_.integrator, substeps_);
+                                s.seed, loss_.integrator, substeps_, loss_.norm);
   return tasks::train(objective, with_train_config(loop, s.train));
 }
 

@@ -290,6 +290,16 @@ const TrainOption kOptions[] = {
      .sweep_rank = 25,
      .applies_to = AppliesTo::kFieldTasks,
      .key = "dt"},
+    {.name = "norm",
+     .kind = ValueKind::kChoice,
+     .help = "The rollout loss's error: l2 (mean squared, the default) or l1 (mean absolute, "
+             "Finzi et al.'s; the constrained tasks' default)",
+     .group = kRolloutGroup,
+     .sweep_rank = 33,
+     .applies_to = AppliesTo::kFieldTasks,
+     .key = "norm",
+     .choices = rollout_norm_names,
+     .noun = "norm"},
     {.name = "fit",
      .kind = ValueKind::kChoice,
      .help = "adam, sampled (hidden layers sampled from the data, the last layer by least "

@@ -19,27 +19,43 @@ constexpr Eigen::Index kCurveWindows = 2000;
 // Relative slack of "a near-multiple of dt".
 constexpr double kMultipleSlack = 0.01;
 
+// mean |a - b| over every element, as relu(d) + relu(-d): its derivative is sign(d) (0 at 0).
+template <typename T>
+ad::Var<T> mean_absolute_error(const ad::Var<T>& a, const ad::Var<T>& b) {
+  const ad::Var<T> d = ad::sub(a, b);
+  return ad::mean(ad::add(ad::relu(d), ad::relu(ad::neg(d))));
+}
+
 }  // namespace
+
+std::string_view to_string(RolloutNorm norm) { return norm == RolloutNorm::kL1 ? "l1" : "l2"; }
+
+std::vector<std::string> rollout_norm_names() { return {"l2", "l1"}; }
 
 nlohmann::json RolloutLossConfig::to_json() const {
   if (!rollout) return {{"loss", "derivative"}};
-  return {{"loss", "rollout"},
-          {"integrator", std::string(to_string(integrator))},
-          {"horizon", horizon},
-          {"dt", dt > 0 ? nlohmann::json(dt) : nlohmann::json("sampling interval")}};
+  nlohmann::json j = {{"loss", "rollout"},
+                      {"integrator", std::string(to_string(integrator))},
+                      {"horizon", horizon},
+                      {"dt", dt > 0 ? nlohmann::json(dt) : nlohmann::json("sampling interval")}};
+  if (norm == RolloutNorm::kL1) j["norm"] = "l1";  // runs from before the norm trained on l2
+  return j;
 }
 
 const std::vector<std::string>& rollout_setting_names() {
-  static const std::vector<std::string> names = {"loss", "horizon", "integrator", "dt"};
+  static const std::vector<std::string> names = {"loss", "horizon", "integrator", "dt", "norm"};
   return names;
 }
 
-RolloutLossConfig rollout_loss_config(const nlohmann::json& s, const std::string& task) {
+RolloutLossConfig rollout_loss_config(const nlohmann::json& s, const std::string& task,
+                                      const RolloutLossConfig& defaults) {
   RolloutLossConfig c;
   try {
-    const std::string loss = s.value("loss", std::string("derivative"));
+    const std::string default_loss = defaults.rollout ? "rollout" : "derivative";
+    const std::string loss = s.value("loss", default_loss);
     HNN_TASKS_CHECK(loss == "derivative" || loss == "rollout",
                     "{}: loss '{}' is not one of derivative, rollout", task, loss);
+    if (loss == default_loss) c = defaults;
     c.rollout = loss == "rollout";
     if (s.contains("horizon")) {
       HNN_TASKS_CHECK(s["horizon"].is_number_integer(), "{}: horizon must be an integer, got {}",
@@ -49,14 +65,20 @@ RolloutLossConfig rollout_loss_config(const nlohmann::json& s, const std::string
     if (s.contains("integrator"))
       c.integrator = parse_rollout_integrator(s["integrator"].get<std::string>());
     if (s.contains("dt")) c.dt = s["dt"].get<double>();
+    if (s.contains("norm")) {
+      const std::string norm = s["norm"].get<std::string>();
+      HNN_TASKS_CHECK(norm == "l2" || norm == "l1", "{}: norm '{}' is not one of l2, l1", task,
+                      norm);
+      c.norm = norm == "l1" ? RolloutNorm::kL1 : RolloutNorm::kL2;
+    }
   } catch (const nlohmann::json::exception& e) {
     throw Error(fmt::format("{}: bad rollout-loss settings {}: {}", task, s.dump(), e.what()));
   }
-  HNN_TASKS_CHECK(
-      c.rollout || (!s.contains("horizon") && !s.contains("integrator") && !s.contains("dt")),
-      "{}: --horizon, --integrator and --dt apply to the rollout loss only (add --loss "
-      "rollout)",
-      task);
+  HNN_TASKS_CHECK(c.rollout || (!s.contains("horizon") && !s.contains("integrator") &&
+                                !s.contains("dt") && !s.contains("norm")),
+                  "{}: --horizon, --integrator, --dt and --norm apply to the rollout loss only "
+                  "(add --loss rollout)",
+                  task);
   HNN_TASKS_CHECK(c.horizon >= 1, "{}: horizon must be at least 1 step, got {}", task, c.horizon);
   HNN_TASKS_CHECK(!s.contains("dt") || (c.dt > 0 && std::isfinite(c.dt)),
                   "{}: --dt must be a positive step, got {}", task, c.dt);
@@ -114,7 +136,7 @@ template <typename T>
 RolloutObjective<T>::RolloutObjective(nn::DynamicsModel<T>& model, RolloutWindows train,
                                       RolloutWindows test, Eigen::Index batch_size,
                                       const nn::AdamOptions& adam, std::uint64_t seed,
-                                      RolloutIntegrator integrator, int substeps)
+                                      RolloutIntegrator integrator, int substeps, RolloutNorm norm)
     : model_(model),
       train_(std::move(train)),
       test_(std::move(test)),
@@ -122,6 +144,7 @@ RolloutObjective<T>::RolloutObjective(nn::DynamicsModel<T>& model, RolloutWindow
       sampler_(train_.count(), batch_size, RowSampler::Draw::kWithReplacement, seed),
       integrator_(integrator),
       substeps_(substeps),
+      norm_(norm),
       scratch_(1 + 2 * train_.next.size()) {}
 
 template <typename T>
@@ -149,7 +172,9 @@ ad::Var<T> RolloutObjective<T>::loss(const RolloutWindows& w,
   for (std::size_t j = 0; j < w.next.size(); ++j) {
     const ad::Var<T> h = constant_rows(w.step[j], rows, 1.0 / substeps_, 1 + 2 * j);
     for (int s = 0; s < substeps_; ++s) x = integrator_step(model_, x, h, integrator_);
-    const ad::Var<T> step_loss = nn::mse(x, constant_rows(w.next[j], rows, 1.0, 2 + 2 * j));
+    const ad::Var<T> target = constant_rows(w.next[j], rows, 1.0, 2 + 2 * j);
+    const ad::Var<T> step_loss =
+        norm_ == RolloutNorm::kL1 ? mean_absolute_error(x, target) : nn::mse(x, target);
     total = total.defined() ? total + step_loss : step_loss;
   }
   return total * T(1.0 / double(w.next.size()));

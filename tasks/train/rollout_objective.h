@@ -31,22 +31,34 @@ struct RolloutWindows {
 /// Throws Error when no stretch has horizon + 1 points (naming the longest) or horizon < 1.
 RolloutWindows rollout_windows(const std::vector<Stretch>& stretches, int horizon);
 
-/// How a run trains: its task settings "loss" (derivative or rollout), "horizon", "integrator"
-/// and "dt", the same keys on every task that learns a field from states. Parsed once, where a
-/// run's settings are resolved (tasks/run.cpp), into RunSettings::loss.
+/// How the rollout loss measures a predicted state against the measured one: the mean squared
+/// error, or the mean absolute error (Finzi et al. 2020's trajectory_mae).
+enum class RolloutNorm { kL2, kL1 };
+
+/// "l2" or "l1"; parse throws Error naming both.
+std::string_view to_string(RolloutNorm norm);
+std::vector<std::string> rollout_norm_names();
+
+/// How a run trains: its task settings "loss" (derivative or rollout), "horizon", "integrator",
+/// "dt" and "norm", the same keys on every task that learns a field from states. Parsed once,
+/// where a run's settings are resolved (tasks/run.cpp), into RunSettings::loss.
 struct RolloutLossConfig {
   bool rollout = false;  ///< "loss": "rollout" (else dx/dt targets)
   int horizon = 1;       ///< sampling intervals per window
   RolloutIntegrator integrator = RolloutIntegrator::kRk4;
   double dt = 0;  ///< the step; 0: one step per sampling interval
+  RolloutNorm norm = RolloutNorm::kL2;
 
   /// {"loss", "integrator", "horizon", "dt"} as metrics.json reports them.
   nlohmann::json to_json() const;
 };
 
-/// The keys above. Throws Error (naming `task`) on a bad value, and on horizon, integrator or
-/// dt without "loss": "rollout".
-RolloutLossConfig rollout_loss_config(const nlohmann::json& settings, const std::string& task);
+/// The keys above over a task's default loss (Task::default_loss): without "loss", or with the
+/// default's own "loss", the keys given change the default; "loss": "derivative" over a rollout
+/// default starts afresh. Throws Error (naming `task`) on a bad value, and on horizon,
+/// integrator, dt or norm without the rollout loss.
+RolloutLossConfig rollout_loss_config(const nlohmann::json& settings, const std::string& task,
+                                      const RolloutLossConfig& defaults = {});
 const std::vector<std::string>& rollout_setting_names();
 
 /// Sub-steps per sampling interval: 1 for dt 0, else round(interval / dt), the same for every
@@ -60,7 +72,8 @@ class RolloutObjective : public Objective<T> {
   /// Each interval is integrated in `substeps` equal steps of `integrator`.
   RolloutObjective(nn::DynamicsModel<T>& model, RolloutWindows train, RolloutWindows test,
                    Eigen::Index batch_size, const nn::AdamOptions& adam, std::uint64_t seed,
-                   RolloutIntegrator integrator = RolloutIntegrator::kRk4, int substeps = 1);
+                   RolloutIntegrator integrator = RolloutIntegrator::kRk4, int substeps = 1,
+                   RolloutNorm norm = RolloutNorm::kL2);
 
   nn::Module<T>& model() override { return model_; }
   std::vector<nn::AdamGroup<T>> parameter_groups() const override {
@@ -72,7 +85,8 @@ class RolloutObjective : public Objective<T> {
   std::uint64_t data_fingerprint() const override;
 
  private:
-  // The mean squared error of the predicted states over every step of `rows` of `w`.
+  // The mean squared (or absolute) error of the predicted states over every step of `rows` of
+  // `w`.
   ad::Var<T> loss(const RolloutWindows& w, const std::vector<Eigen::Index>* rows) const;
 
   // The rows of `m` picked by `rows` (all with nullptr), scaled, as a tape constant; gathered in
@@ -86,6 +100,7 @@ class RolloutObjective : public Objective<T> {
   RowSampler sampler_;
   RolloutIntegrator integrator_;
   int substeps_;
+  RolloutNorm norm_;
   mutable std::vector<ad::Matrix<T>> scratch_;
 };
 

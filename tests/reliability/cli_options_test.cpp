@@ -55,7 +55,7 @@ std::vector<BadOption> bad_train_options() {
        "task 'spring' does not read a data file (--data applies to measured-data tasks such as "
        "real-pendulum)"},
       {{"train", "spring", "--settings", "{\"trials\": 20}"},
-       "task 'spring' has no setting 'trials' (known: loss, horizon, integrator, dt, "
+       "task 'spring' has no setting 'trials' (known: loss, horizon, integrator, dt, norm, "
        "baseline_output, fit, sampler, rcond, solver, regularization, solver_tolerance, "
        "solver_iterations, sample_dt, "
        "t_end, rollouts, rollout_t_end)"},
@@ -133,7 +133,9 @@ TEST(CliOptions, BadCommandsAndOtherSubcommandsGetOneLine) {
       {{"reproduce", "--tasks", "spring,nope", "--out", (dir / "results").string()},
        "unknown task 'nope' (known: spring, pendulum, real-pendulum, two-body, three-body, "
        "pixel-pendulum, damped-spring, double-pendulum, real-double-pendulum, henon-heiles, "
-       "pendulum-scattered, double-pendulum-scattered, data)"},
+       "pendulum-scattered, double-pendulum-scattered, chain-pendulum-2, chain-pendulum-3, "
+       "chain-pendulum-4, chain-pendulum-5, coupled-pendulums, magnet-pendulum, gyroscope, rotor, "
+       "data)"},
       {{"reproduce", "--tasks", "data", "--out", (dir / "results").string()},
        "reproduce runs the paper's tasks (spring, pendulum, real-pendulum, two-body, three-body, "
        "pixel-pendulum); 'data' is not one of them: train it with hnn train data"},
@@ -259,7 +261,7 @@ TEST(TrainOptionsTable, TheSweepKeysAreItsRowsInRankOrderAndTheOthersAreRefusedW
       "data": "x.csv", "settings": {"threshold": 0.2}, "checkpoint-every": 2, "coords": "q",
       "momenta": "p", "velocities": "v", "derivatives": "dq,dp", "time": "t",
       "trajectory": "traj", "split": "time", "test-fraction": 0.3, "hamiltonian": "q^2",
-      "loss": "rollout", "horizon": 2, "integrator": "leapfrog", "dt": 0.05,
+      "loss": "rollout", "horizon": 2, "integrator": "leapfrog", "dt": 0.05, "norm": "l1",
       "fit": "sampled+adam", "sampler": "aswim", "rcond": 1e-10, "solver": "qr",
       "regularization": 1e-9, "solver-tolerance": 1e-10, "solver-iterations": 50,
       "baseline-output": "field"})");

@@ -154,6 +154,20 @@ std::string energy_lines(const json& m) {
   return out;
 }
 
+// The constrained tasks' metric (Finzi et al.'s, in Cartesian (x, v)), its floor and the failed
+// rollouts, which it does not pool.
+std::string constrained_line(const json& m) {
+  const std::optional<double> error = number_at(m, "cartesian_error");
+  const std::optional<double> failed = number_at(m, "cartesian_error_failed");
+  if (!failed) return "";
+  std::string line = fmt::format("  rollouts   Cartesian relative error (geometric mean) {}",
+                                 error ? fmt::format("{:.3g}", *error) : std::string("none"));
+  if (const auto floor = number_at(m, "cartesian_error_floor"))
+    line += fmt::format(", floor {:.3g}", *floor);
+  return line + fmt::format("; failed rollouts {:g} of {:g}\n", *failed,
+                            number_at(m, "cartesian_error_rollouts").value_or(NAN));
+}
+
 std::string timing_line(const json& m) {
   constexpr std::pair<const char*, const char*> kTimes[] = {
       {"train_seconds", "training"}, {"data_seconds", "data"}, {"eval_seconds", "evaluation"}};
@@ -170,8 +184,9 @@ std::string timing_line(const json& m) {
 }  // namespace
 
 std::string metrics_summary(const json& m) {
-  return heading_line(m) + "\n" + loss_lines(m) + prediction_line(m) + skipped_rollouts_line(m) +
-         hamiltonian_line(m) + energy_lines(m) + fit_line(m) + timing_line(m);
+  return heading_line(m) + "\n" + loss_lines(m) + prediction_line(m) + constrained_line(m) +
+         skipped_rollouts_line(m) + hamiltonian_line(m) + energy_lines(m) + fit_line(m) +
+         timing_line(m);
 }
 
 void print_warnings(const json& metrics) {

@@ -93,9 +93,21 @@ std::vector<Group> default_study() {
                     {"settings", {{"energy_t_end", 20}, {"rollouts", 15}}}};
   dhnn_real.headline = "held_out_energy_mse";
   dhnn_real.metrics = {"valid_prediction_time"};
+  // Finzi et al.'s constrained systems at their protocol, each task's default (through RK4 over
+  // 5-output chunks, L1): the chains in angles for the HNN and LNN, the rest Cartesian only.
+  Group chains = crossed({"chain-pendulum-2", "chain-pendulum-3", "chain-pendulum-5"},
+                         {"baseline", "hnn", "lnn"}, {"rollout"});
+  chains.metrics = {"cartesian_error_floor", "cartesian_error_failed"};
+  Group bodies = crossed({"gyroscope", "rotor", "magnet-pendulum", "coupled-pendulums"},
+                         {"baseline", "hnn"}, {"rollout"});
+  bodies.metrics = chains.metrics;
   return {crossed({"real-pendulum", "damped-spring"}, {"baseline", "hnn", "dhnn"}, {"derivative"}),
-          dhnn_real, crossed({"double-pendulum"}, {"baseline", "hnn", "lnn"}, {"derivative"}),
-          three_body, coarse_spring};
+          dhnn_real,
+          crossed({"double-pendulum"}, {"baseline", "hnn", "lnn"}, {"derivative"}),
+          three_body,
+          coarse_spring,
+          chains,
+          bodies};
 }
 
 // One row of the table: a (task, model, loss) at its protocol's keys, and its runs, or why it
@@ -152,6 +164,16 @@ constexpr std::array<const char*, 5> kAdamKeys = {"steps", "batch", "lr", "lr-sc
 
 bool takes_steps(const std::string& fit) { return fit != "sampled"; }
 
+// The loss a task trains with unless told (Task::default_loss): rows of it leave "loss" out, so
+// their run folders keep the names they had. An unknown task (a skipped row) trains none.
+std::string default_loss(const std::string& task) {
+  try {
+    return tasks::make_task(task)->default_loss().rollout ? "rollout" : "derivative";
+  } catch (const tasks::Error&) {
+    return "derivative";
+  }
+}
+
 // The sweep spec of one row: its task, model, loss and fit, and the seeds (and steps) of the
 // study.
 ordered_json row_spec(const Row& row, const CompareOptions& o) {
@@ -163,7 +185,7 @@ ordered_json row_spec(const Row& row, const CompareOptions& o) {
   spec["seed"] = seeds;
   for (const auto& [key, value] : row.keys.items()) spec[key] = ordered_json::array({value});
   if (o.steps > 0 && takes_steps(row.fit)) spec["steps"] = {o.steps};  // over the protocol's
-  if (row.loss != "derivative") spec["loss"] = {row.loss};  // derivative: hnn train's default
+  if (row.loss != default_loss(row.task)) spec["loss"] = {row.loss};
   if (row.fit != "adam") spec["fit"] = {row.fit};           // adam: hnn train's default
   return spec;
 }
@@ -275,6 +297,7 @@ json compare_section(const std::vector<Row>& rows, const CompareOptions& o) {
           {"peers_file", fs::absolute(file).lexically_normal().string()},
           {"headline", peers_doc.value("headline", json::object())},
           {"report_metrics", peers_doc.value("report_metrics", json::array({"test_loss"}))},
+          {"geometric_metrics", peers_doc.value("geometric_metrics", json::array())},
           {"hnn_tasks", tasks::task_names()},
           {"rows", rows_json(rows)},
           {"peers", peers}};

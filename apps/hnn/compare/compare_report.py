@@ -89,8 +89,19 @@ def row_label(row):
     return task, f"{loss} ({extra})" if extra else loss
 
 
-def summarise(row, by_run):
-    """The row's runs: their states, and the mean and error of every numeric metric."""
+def geometric_mean_se(values):
+    """exp(mean(log v)) and its standard error by the delta method (g times the standard error of
+    the logs), for errors the peer pools geometrically; with a value <= 0, the arithmetic ones."""
+    if any(v <= 0 for v in values):
+        return mean_se(values)
+    m, se = mean_se([math.log(v) for v in values])
+    g = math.exp(m)
+    return g, (None if se is None else g * se)
+
+
+def summarise(row, by_run, geometric=()):
+    """The row's runs: their states, and the mean and error of every numeric metric (geometric
+    for the peers file's geometric_metrics)."""
     runs = [by_run[name] for name in row["runs"] if name in by_run]
     done = [r for r in runs if r["status"] == "done"]
     failed = [{"run": r["run"], "reason": r["reason"]} for r in runs if r["status"] == "failed"]
@@ -99,7 +110,7 @@ def summarise(row, by_run):
     metrics = {}
     for k in keys:
         values = [m[k] for m in flat if is_number(m.get(k))]
-        m, se = mean_se(values)
+        m, se = geometric_mean_se(values) if k in geometric else mean_se(values)
         metrics[k] = {"mean": m, "se": se, "n": len(values)}
     if row["skipped"]:
         status = "skipped"
@@ -169,7 +180,8 @@ def build(plan, table):
     peers = section["peers"]
     rows = []
     for row in section["rows"]:
-        status, done, failed, metrics = summarise(row, by_run)
+        status, done, failed, metrics = summarise(row, by_run,
+                                                  section.get("geometric_metrics", []))
         mine = [p for p in peers if peer_matches(p, row)] if not row["skipped"] else []
         rows.append({"task": row["task"], "model": model_label(row), "loss": row["loss"],
                      "fit": row.get("fit", "adam"),

@@ -1,0 +1,279 @@
+// The constrained systems of Finzi, Wang & Wilson 2020 (physics/constrained/), one task each, at
+// their protocol (their pl_trainer.py): 800 training trajectories, each cut to one random chunk
+// of 5 outputs; the model's field integrated by RK4 over the chunk with an L1 loss; 3 x 256
+// networks, lr 3e-3 with a cosine schedule, batch 200, 2000 epochs (8,000 steps); 100 test
+// rollouts of one trajectory length (100 outputs) from chunk starts, scored by their metric in
+// Cartesian (x, v) with its floor and the failed rollouts counted.
+//
+// The baseline learns the Cartesian state z = (x, v). On the chains the HNN learns the angle twin
+// (theta, p) and the LNN (theta, omega) (physics/constrained/chain_angles.h); their rollouts are
+// mapped to Cartesian (x, v) before the metric, so every model is scored alike.
+
+#include <fmt/format.h>
+
+#include <cmath>
+
+#include "physics/constrained/chain_angles.h"
+#include "physics/constrained/metric.h"
+#include "physics/constrained/systems.h"
+#include "tasks/experiments/registry.h"
+#include "tasks/field/field_task.h"
+#include "tasks/report/json_values.h"
+
+namespace hnn::tasks {
+
+namespace {
+
+namespace pc = physics::constrained;
+using nlohmann::json;
+
+constexpr int kChunkOutputs = 5;              // the peer's chunk_len
+constexpr int kTrainTrajectories = 800;       // the peer's n_train
+constexpr int kValidationTrajectories = 100;  // the peer's n_val: the test split of the loss curve
+constexpr int kPeerBatch = 200, kPeerEpochs = 2000;
+constexpr int kMaxChunkedTrajectories = 100'000;
+// The floor's perturbation draws: one fixed generator, so that every model of a run's seed is
+// measured against the same floor (the starts depend on the seed).
+constexpr std::uint64_t kConstrainedFloorSeed = 0x5eed;
+
+// The state a model learns: the system's own, or the chain's angles with canonical momenta
+// (HNN) or angular velocities (LNN).
+enum class Coordinates { kCartesian, kAngles, kAngleVelocities };
+
+Coordinates model_coordinates(nn::ModelKind model) {
+  if (model == nn::ModelKind::kHnn) return Coordinates::kAngles;
+  if (model == nn::ModelKind::kLnn) return Coordinates::kAngleVelocities;
+  return Coordinates::kCartesian;
+}
+
+struct ConstrainedEntry {
+  const char* task;
+  const char* system;  // physics/constrained/systems.h
+  int links;           // 0: not a chain (no angle twin)
+  const char* summary;
+};
+
+int trajectory_count(const json& s, const char* key, int fallback, const std::string& task) {
+  if (!s.contains(key)) return fallback;
+  HNN_TASKS_CHECK(s[key].is_number_integer() && s[key].get<long>() >= 1 &&
+                      s[key].get<long>() <= kMaxChunkedTrajectories,
+                  "{}: {} must be an integer in 1..{}, got {}", task, key, kMaxChunkedTrajectories,
+                  s[key].dump());
+  return s[key].get<int>();
+}
+
+class ConstrainedTask : public FieldTask {
+ public:
+  ConstrainedTask(const ConstrainedEntry& entry, Coordinates coordinates)
+      : entry_(entry),
+        coordinates_(coordinates),
+        cartesian_(pc::make_constrained_system(entry.system)) {
+    if (entry.links > 0) {
+      angles_ = std::make_unique<pc::ChainPendulumAngles>(entry.links);
+      velocities_ = std::make_unique<pc::ChainPendulumVelocities>(entry.links);
+    }
+    // The registered task (Cartesian) opens the angle models' runs through its twins.
+    if (coordinates == Coordinates::kCartesian && entry.links > 0) {
+      angle_twin_ = std::make_unique<ConstrainedTask>(entry, Coordinates::kAngles);
+      velocity_twin_ = std::make_unique<ConstrainedTask>(entry, Coordinates::kAngleVelocities);
+    }
+  }
+
+  std::string name() const override { return entry_.task; }
+  std::string summary() const override { return entry_.summary; }
+  TrainConfig train_config() const override {
+    return {.steps = kPeerEpochs * kTrainTrajectories / kPeerBatch,
+            .batch_size = kPeerBatch,
+            .learning_rate = 3e-3,
+            .weight_decay = 1e-4,
+            .lr_schedule = LrSchedule::kCosine,
+            .hidden = {256, 256, 256}};
+  }
+  RolloutLossConfig default_loss() const override {
+    return {.rollout = true,
+            .horizon = kChunkOutputs - 1,
+            .integrator = RolloutIntegrator::kRk4,
+            .norm = RolloutNorm::kL1};
+  }
+  std::string table_note() const override {
+    return fmt::format(
+        "{}: cartesian_error is Finzi et al.'s geometric-mean relative error in Cartesian (x, v) "
+        "over 100 test rollouts of 100 outputs, beside its floor and the failed rollouts.",
+        entry_.task);
+  }
+  std::vector<nn::ModelKind> models() const override {
+    if (entry_.links == 0) return {nn::ModelKind::kBaseline};
+    return {nn::ModelKind::kBaseline, nn::ModelKind::kHnn, nn::ModelKind::kLnn};
+  }
+  std::string refusal_reason(nn::ModelKind model) const override {
+    if (model != nn::ModelKind::kHnn && model != nn::ModelKind::kLnn) return "";
+    return fmt::format(
+        ": an {} learns this system in angle coordinates, which hnn has for the chain pendulums "
+        "only (physics/constrained/chain_angles.h), not for the {}",
+        nn::to_string(model), entry_.system);
+  }
+  std::vector<std::string> own_setting_names() const override {
+    return {"trajectories", "validation"};
+  }
+  Eigen::Index angle_coordinates() const override {
+    return coordinates_ == Coordinates::kCartesian ? 0 : entry_.links;
+  }
+
+  std::unique_ptr<TaskRun> open(const RunSettings& settings) const override {
+    const Coordinates c = model_coordinates(settings.model);
+    if (c == coordinates_ || entry_.links == 0) return FieldTask::open(settings);
+    const ConstrainedTask& twin = c == Coordinates::kAngles ? *angle_twin_ : *velocity_twin_;
+    return twin.FieldTask::open(settings);
+  }
+
+  const physics::System& truth() const override {
+    if (coordinates_ == Coordinates::kAngles) return *angles_;
+    if (coordinates_ == Coordinates::kAngleVelocities) return *velocities_;
+    return cartesian_;
+  }
+
+  Dataset build_dataset(const RunSettings& settings) const override {
+    const int train =
+        trajectory_count(settings.task_settings, "trajectories", kTrainTrajectories, name());
+    const int test =
+        trajectory_count(settings.task_settings, "validation", kValidationTrajectories, name());
+    std::mt19937_64 rng(settings.seed);
+    const Batch train_x = chunk_rows(pc::sample_chunks(cartesian_, train, kChunkOutputs, rng));
+    const Batch test_x = chunk_rows(pc::sample_chunks(cartesian_, test, kChunkOutputs, rng));
+    Batch train_dxdt, test_dxdt;
+    truth().vector_field(train_x, train_dxdt);
+    truth().vector_field(test_x, test_dxdt);
+    return {train_x, train_dxdt, test_x, test_dxdt};
+  }
+
+  std::optional<SplitStretches> stretches(const RunSettings&, const Dataset& data) const override {
+    const double span = (kChunkOutputs - 1) * cartesian_.spec().dt;
+    return SplitStretches{regular_stretches(data.train_x, kChunkOutputs, span),
+                          regular_stretches(data.test_x, kChunkOutputs, span)};
+  }
+
+  // The peer's test starts: the first states of random chunks of sampled trajectories.
+  Batch rollout_states(const Dataset&, int count, std::mt19937_64& rng) const override {
+    pc::ChunkSample sample = pc::sample_chunks(cartesian_, count, kChunkOutputs, rng);
+    sample.states.resize(1);
+    return in_coordinates(std::move(sample.states)).front();
+  }
+
+  // One trajectory length: the peer's output times (0, dt, ... below the horizon), the model
+  // integrated by dopri5 at the peer's tolerance 1e-7. No perturbed truth in the model's
+  // coordinates: add_metrics measures the peer's floor in Cartesian ones.
+  RolloutConfig rollout_config() const override {
+    const int points = int(cartesian_.output_times().size());
+    return {.t_end = cartesian_.spec().dt * (points - 1),
+            .points = points,
+            .rtol = 1e-7,
+            .atol = 1e-9,
+            .perturbation = 0};
+  }
+
+  // The peer's metric in Cartesian (x, v) against a tight truth, the same for every model; its
+  // floor where the span is the peer's (floor_score integrates over the system's output times).
+  void add_metrics(const Rollouts& r, json& metrics) const override {
+    std::vector<Batch> predicted = per_time(r.pred);
+    for (Batch& b : predicted) b = to_cartesian(b);
+    const Batch z0 = to_cartesian(per_time(r.truth).front());
+    const std::vector<Batch> truth = pc::simulate_constrained(cartesian_, z0, r.t).states;
+    const double dt = r.t[1] - r.t[0];
+    const pc::RolloutScore score =
+        pc::score_rollouts(predicted, truth, dt, dt * double(r.t.size()));
+    metrics["cartesian_error"] = number(score.geometric_mean);
+    metrics["cartesian_error_failed"] = score.failed;
+    metrics["cartesian_error_rollouts"] = int(z0.rows());
+    if (r.t.size() == cartesian_.output_times().size()) {
+      std::mt19937_64 rng(kConstrainedFloorSeed);
+      metrics["cartesian_error_floor"] =
+          number(pc::floor_score(cartesian_, z0, truth, rng).score.geometric_mean);
+    } else {
+      metrics["cartesian_error_note"] = "no floor: the rollouts' span is not the peer's";
+    }
+    metrics["coordinates"] = coordinates_ == Coordinates::kCartesian ? "cartesian"
+                             : coordinates_ == Coordinates::kAngles  ? "angles (theta, p)"
+                                                                     : "angles (theta, omega)";
+  }
+
+  // Cartesian (x, v) rows of states in this task's coordinates.
+  Batch to_cartesian(const Batch& x) const {
+    if (coordinates_ == Coordinates::kAngles) return angles_->to_cartesian(x);
+    if (coordinates_ == Coordinates::kAngleVelocities) return velocities_->to_cartesian(x);
+    return x;
+  }
+
+ private:
+  // Cartesian states, one batch per time, in this task's coordinates: angles continuous along
+  // time (a chunk crossing theta = pi carries no 2 pi jump).
+  std::vector<Batch> in_coordinates(std::vector<Batch> states) const {
+    if (coordinates_ == Coordinates::kCartesian) return states;
+    for (Batch& b : states) b = pc::chain_angles(entry_.links, b);
+    pc::unwrap_angles(states, entry_.links);
+    if (coordinates_ == Coordinates::kAngles)
+      for (Batch& b : states) b = angles_->momenta_from_velocities(b);
+    return states;
+  }
+
+  // A chunk sample as rows, chunk after chunk, each chunk's kChunkOutputs states in time order.
+  Batch chunk_rows(const pc::ChunkSample& sample) const {
+    const std::vector<Batch> states = in_coordinates(sample.states);
+    const Eigen::Index n = states.front().rows();
+    Batch rows(n * kChunkOutputs, states.front().cols());
+    for (Eigen::Index i = 0; i < n; ++i)
+      for (int k = 0; k < kChunkOutputs; ++k)
+        rows.row(i * kChunkOutputs + k) = states[std::size_t(k)].row(i);
+    return rows;
+  }
+
+  // Per-trajectory paths (times x dim) -> one batch per time (trajectories x dim).
+  static std::vector<Batch> per_time(const std::vector<Eigen::MatrixXd>& paths) {
+    std::vector<Batch> out(std::size_t(paths.front().rows()),
+                           Batch(Eigen::Index(paths.size()), paths.front().cols()));
+    for (std::size_t i = 0; i < paths.size(); ++i)
+      for (std::size_t k = 0; k < out.size(); ++k)
+        out[k].row(Eigen::Index(i)) = paths[i].row(Eigen::Index(k));
+    return out;
+  }
+
+  ConstrainedEntry entry_;
+  Coordinates coordinates_;
+  pc::ConstrainedSystem cartesian_;
+  std::unique_ptr<pc::ChainPendulumAngles> angles_;
+  std::unique_ptr<pc::ChainPendulumVelocities> velocities_;
+  std::unique_ptr<ConstrainedTask> angle_twin_, velocity_twin_;
+};
+
+constexpr ConstrainedEntry kConstrainedEntries[] = {
+    {"chain-pendulum-2", "chain_pendulum_2", 2,
+     "2-link chain pendulum in Cartesian coordinates (Finzi et al. 2020)"},
+    {"chain-pendulum-3", "chain_pendulum_3", 3,
+     "3-link chain pendulum in Cartesian coordinates (Finzi et al. 2020)"},
+    {"chain-pendulum-4", "chain_pendulum_4", 4,
+     "4-link chain pendulum in Cartesian coordinates (Finzi et al. 2020)"},
+    {"chain-pendulum-5", "chain_pendulum_5", 5,
+     "5-link chain pendulum in Cartesian coordinates (Finzi et al. 2020)"},
+    {"coupled-pendulums", "coupled_pendulums_3", 0,
+     "3 spherical pendulums joined by springs, Cartesian (Finzi et al. 2020)"},
+    {"magnet-pendulum", "magnet_pendulum", 0,
+     "spherical pendulum over two magnets, Cartesian (Finzi et al. 2020)"},
+    {"gyroscope", "gyroscope", 0,
+     "gyroscope as constrained point masses, Cartesian (Finzi et al. 2020)"},
+    {"rotor", "rotor", 0, "free rotor as constrained point masses, Cartesian (Finzi et al. 2020)"},
+};
+
+}  // namespace
+
+std::vector<std::string> constrained_task_names() {
+  std::vector<std::string> names;
+  for (const ConstrainedEntry& e : kConstrainedEntries) names.push_back(e.task);
+  return names;
+}
+
+std::unique_ptr<Task> make_constrained_task(const std::string& name) {
+  for (const ConstrainedEntry& e : kConstrainedEntries)
+    if (name == e.task) return std::make_unique<ConstrainedTask>(e, Coordinates::kCartesian);
+  throw Error(fmt::format("no constrained task '{}'", name));
+}
+
+}  // namespace hnn::tasks

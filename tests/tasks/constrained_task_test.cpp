@@ -1,0 +1,136 @@
+// The constrained systems' tasks (tasks/experiments/constrained.cpp): Finzi et al.'s data (one
+// 5-output chunk per trajectory), a run end to end with their metric, its floor and the failed
+// rollouts; an angle model's rollouts scored in Cartesian coordinates; the refusals; and the
+// task's default loss (RK4 over the chunk, L1) with the keys that change it.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "physics/constrained/chain_angles.h"
+#include "physics/constrained/metric.h"
+#include "physics/constrained/systems.h"
+#include "tasks/evaluate/rollouts.h"
+#include "tasks/experiments/registry.h"
+#include "tasks/run.h"
+#include "test_configs.h"
+
+namespace hnn::tasks {
+namespace {
+
+namespace pc = physics::constrained;
+using testing::TempDir;
+
+// A few short trajectories, a few rollouts: seconds, not the protocol's minutes.
+RunOptions tiny(const std::string& model, const std::filesystem::path& out,
+                const std::string& task = "chain-pendulum-2") {
+  RunOptions o = testing::small_run(task, model, out, 3);
+  o.batch_size = 4;
+  o.task_settings = {{"trajectories", 6}, {"validation", 2}, {"rollouts", 2}};
+  return o;
+}
+
+TEST(ConstrainedTask, HasThePeersProtocolAsItsDefaults) {
+  const std::unique_ptr<Task> task = make_task("chain-pendulum-2");
+  const TrainConfig c = task->train_config();
+  EXPECT_EQ(c.steps, 8000);  // 2000 epochs of 800 trajectories in batches of 200
+  EXPECT_EQ(c.batch_size, 200);
+  EXPECT_EQ(c.hidden, (std::vector<int>{256, 256, 256}));
+  EXPECT_EQ(c.learning_rate, 3e-3);
+  EXPECT_EQ(c.weight_decay, 1e-4);
+  EXPECT_EQ(c.lr_schedule, LrSchedule::kCosine);
+  const RolloutLossConfig loss = task->default_loss();
+  EXPECT_TRUE(loss.rollout);
+  EXPECT_EQ(loss.horizon, 4);
+  EXPECT_EQ(loss.norm, RolloutNorm::kL1);
+  // Chunks of 5 states along the constrained truth: on the manifold, each chunk dt apart.
+  const Dataset d = make_field_task("chain-pendulum-2")
+                        ->build_dataset(RunSettings{.task = "chain-pendulum-2",
+                                                    .model = nn::ModelKind::kBaseline,
+                                                    .seed = 1,
+                                                    .task_settings = {{"trajectories", 6}}});
+  EXPECT_EQ(d.train_x.rows(), 30);
+  EXPECT_EQ(d.test_x.rows(), 500);  // 100 validation trajectories
+  const pc::ConstrainedSystem chain = pc::chain_pendulum(2);
+  EXPECT_LT(chain.constraint_values(d.train_x).cwiseAbs().maxCoeff(), 1e-8);
+  const Batch next = pc::simulate_constrained(chain, d.train_x.topRows(1), {0.0, 0.03}).states[1];
+  EXPECT_LT((next - d.train_x.row(1)).cwiseAbs().maxCoeff(), 1e-8);
+}
+
+TEST(ConstrainedTask, RunsEndToEndWithTheMetricItsFloorAndTheFailedCount) {
+  TempDir dir("runs");
+  const nlohmann::json m = run_training(tiny("baseline", dir / "b"));
+  ASSERT_TRUE(m.contains("cartesian_error")) << m.dump();
+  EXPECT_EQ(m["cartesian_error_rollouts"], 2);
+  EXPECT_GE(m["cartesian_error_failed"].get<int>(), 0);
+  EXPECT_EQ(m["coordinates"], "cartesian");
+  // The peer's floor on the 2-chain is 5.9e-5 over 100 starts; over 2 it is of that order.
+  EXPECT_GT(m["cartesian_error_floor"].get<double>(), 1e-6);
+  EXPECT_LT(m["cartesian_error_floor"].get<double>(), 1e-3);
+  EXPECT_EQ(m["training"]["loss"], "rollout");
+  EXPECT_EQ(m["training"]["norm"], "l1");
+  EXPECT_EQ(m["training"]["horizon"], 4);
+}
+
+TEST(ConstrainedTask, AnAngleModelIsScoredInCartesianCoordinates) {
+  TempDir dir("runs");
+  const nlohmann::json m = run_training(tiny("hnn", dir / "h"));
+  EXPECT_EQ(m["coordinates"], "angles (theta, p)");
+  const LoadedRun loaded = load_run(dir / "h");
+  const Batch x0 = loaded.run->rollout_states(2);
+  ASSERT_EQ(x0.cols(), 4);  // (theta, p) of two links
+  // The model's rollouts in angles, mapped to Cartesian, against the Cartesian truth.
+  const pc::ChainPendulumAngles angles(2);
+  const std::vector<double> t = angles.cartesian().output_times();
+  const Rollouts r = make_rollouts(
+      angles, loaded.run->dynamics(), x0,
+      {.t_end = t.back(), .points = int(t.size()), .rtol = 1e-7, .atol = 1e-9, .perturbation = 0});
+  std::vector<Batch> predicted(t.size(), Batch(2, 8));
+  for (std::size_t k = 0; k < t.size(); ++k)
+    for (Eigen::Index i = 0; i < 2; ++i)
+      predicted[k].row(i) =
+          angles.to_cartesian(Batch(r.pred[std::size_t(i)].row(Eigen::Index(k)))).row(0);
+  const std::vector<Batch> truth =
+      pc::simulate_constrained(angles.cartesian(), angles.to_cartesian(x0), t).states;
+  const pc::RolloutScore score = pc::score_rollouts(predicted, truth, 0.03, 3.0);
+  EXPECT_NEAR(m["cartesian_error"].get<double>(), score.geometric_mean,
+              1e-9 * score.geometric_mean);
+  EXPECT_EQ(m["cartesian_error_failed"], score.failed);
+}
+
+TEST(ConstrainedTask, RefusesAngleModelsWhereHnnHasNoAngles) {
+  TempDir dir("runs");
+  for (const char* model : {"hnn", "lnn"}) {
+    try {
+      run_training(tiny(model, dir / model, "gyroscope"));
+      FAIL() << model << " accepted";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("angle coordinates"), std::string::npos) << e.what();
+    }
+    EXPECT_FALSE(std::filesystem::exists(dir / model));
+  }
+  RunOptions o = tiny("baseline", dir / "bad");
+  o.task_settings["trajectories"] = 0;
+  EXPECT_THROW(run_training(o), Error);
+}
+
+TEST(RolloutLoss, ATasksDefaultLossAndTheNormKey) {
+  const RolloutLossConfig chunks{.rollout = true, .horizon = 4, .norm = RolloutNorm::kL1};
+  RolloutLossConfig c = rollout_loss_config(nlohmann::json::object(), "t", chunks);
+  EXPECT_TRUE(c.rollout);
+  EXPECT_EQ(c.horizon, 4);
+  EXPECT_EQ(c.norm, RolloutNorm::kL1);
+  c = rollout_loss_config({{"loss", "rollout"}, {"norm", "l2"}}, "t", chunks);
+  EXPECT_EQ(c.horizon, 4);
+  EXPECT_EQ(c.norm, RolloutNorm::kL2);
+  c = rollout_loss_config({{"loss", "derivative"}}, "t", chunks);
+  EXPECT_FALSE(c.rollout);
+  EXPECT_EQ(c.norm, RolloutNorm::kL2);
+  EXPECT_EQ(rollout_loss_config({{"loss", "rollout"}, {"norm", "l1"}}, "t").norm, RolloutNorm::kL1);
+  EXPECT_THROW(rollout_loss_config({{"norm", "l1"}}, "t"), Error);  // dx/dt targets
+  EXPECT_THROW(rollout_loss_config({{"loss", "rollout"}, {"norm", "l3"}}, "t"), Error);
+  EXPECT_EQ(rollout_loss_config({{"loss", "rollout"}}, "t").to_json().count("norm"), 0u);
+}
+
+}  // namespace
+}  // namespace hnn::tasks
