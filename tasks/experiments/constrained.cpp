@@ -13,6 +13,7 @@
 
 #include <cmath>
 
+#include "nn/constrained/constraints.h"
 #include "physics/constrained/chain_angles.h"
 #include "physics/constrained/metric.h"
 #include "physics/constrained/systems.h"
@@ -62,6 +63,22 @@ int trajectory_count(const json& s, const char* key, int fallback, const std::st
   return s[key].get<int>();
 }
 
+// The system as the CHNN and CLNN see it (nn/constrained/constraints.h): its points, masses
+// and constraints, one to one; the potential is what they learn.
+nn::ConstraintSpec model_constraints(const pc::ConstrainedSpec& spec) {
+  const auto values = [](const Eigen::VectorXd& v) {
+    return std::vector<double>(v.data(), v.data() + v.size());
+  };
+  nn::ConstraintSpec c{.points = spec.points, .dim = spec.dim, .mass = spec.mass};
+  for (const pc::DistanceConstraint& d : spec.distances) c.links.push_back({d.i, d.j, d.length});
+  for (const pc::AnchorConstraint& a : spec.anchors) {
+    c.anchors.push_back({a.i, values(a.anchor), a.length});
+  }
+  for (const pc::PinConstraint& p : spec.pins)
+    c.pins.push_back({values(p.weights), values(p.point)});
+  return c;
+}
+
 class ConstrainedTask : public FieldTask {
  public:
   ConstrainedTask(const ConstrainedEntry& entry, Coordinates coordinates)
@@ -102,9 +119,12 @@ class ConstrainedTask : public FieldTask {
         entry_.task);
   }
   std::vector<nn::ModelKind> models() const override {
-    if (entry_.links == 0) return {nn::ModelKind::kBaseline};
-    return {nn::ModelKind::kBaseline, nn::ModelKind::kHnn, nn::ModelKind::kLnn};
+    using nn::ModelKind;
+    if (entry_.links == 0) return {ModelKind::kBaseline, ModelKind::kChnn, ModelKind::kClnn};
+    return {ModelKind::kBaseline, ModelKind::kHnn, ModelKind::kLnn, ModelKind::kChnn,
+            ModelKind::kClnn};
   }
+  nn::ConstraintSpec constraints() const override { return model_constraints(cartesian_.spec()); }
   std::string refusal_reason(nn::ModelKind model) const override {
     if (model != nn::ModelKind::kHnn && model != nn::ModelKind::kLnn) return "";
     return fmt::format(

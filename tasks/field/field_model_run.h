@@ -19,6 +19,7 @@ struct ModelInput {
   Eigen::Index angles = 0;
   std::vector<double> input_scale{};
   bool given_velocities = false;
+  nn::ConstraintSpec constraints{};  ///< the system a CHNN or CLNN is built on
 };
 
 class FieldModelRun : public TaskRun {
@@ -65,6 +66,7 @@ class FieldModelRun : public TaskRun {
                               .dim = data_.train_x.cols(),
                               .angles = input_.angles,
                               .input_scale = input_.input_scale,
+                              .constraints = input_.constraints,
                               .given_velocities = input_.given_velocities};
     if (s_.model == nn::ModelKind::kDhnn) config.field = nn::FieldType::kBoth;
     config.hidden.assign(s_.train.hidden.begin(), s_.train.hidden.end());

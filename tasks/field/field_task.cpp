@@ -28,7 +28,8 @@ ModelInput model_input(const FieldTask& task, const RunSettings& s) {
   return {.angles = task.angle_coordinates(),
           .input_scale = task.input_scale(),
           .given_velocities = given_velocities(s.task_settings, s.model, s.fit.samples(),
-                                               velocity_state(task), task.name())};
+                                               velocity_state(task), task.name()),
+          .constraints = nn::is_constrained(s.model) ? task.constraints() : nn::ConstraintSpec{}};
 }
 
 class FieldRun : public FieldModelRun {

@@ -70,6 +70,9 @@ class FieldTask : public Task {
   virtual void add_metrics(const Rollouts& rollouts, nlohmann::json& metrics) const;
   /// How many leading coordinates are angles (the models see each as (cos, sin)); by default none.
   virtual Eigen::Index angle_coordinates() const { return 0; }
+  /// The constrained system a CHNN or CLNN is built on (points, masses, constraints); empty
+  /// where the task has none, and those models are not among its models().
+  virtual nn::ConstraintSpec constraints() const { return {}; }
   /// The models' input scales (nn::DynamicsConfig::input_scale); by default none.
   virtual std::vector<double> input_scale() const { return {}; }
 

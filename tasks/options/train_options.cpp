@@ -374,7 +374,7 @@ const TrainOption kOptions[] = {
      .help = "What the baseline's MLP gives: field (all of dx/dt, the default) or accelerations "
              "(dv/dt alone, dq/dt = v given, as the LNN paper's baseline; tasks whose state is "
              "(q, dq/dt): double-pendulum, real-double-pendulum)",
-     .sweep_rank = 33,
+     .sweep_rank = 34,
      .applies_to = AppliesTo::kFieldTasks,
      .key = "baseline_output",
      .choices = baseline_output_names,

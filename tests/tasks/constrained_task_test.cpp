@@ -98,6 +98,40 @@ TEST(ConstrainedTask, AnAngleModelIsScoredInCartesianCoordinates) {
   EXPECT_EQ(m["cartesian_error_failed"], score.failed);
 }
 
+// The CHNN and CLNN get the task's own points, masses and constraints (links and anchors on the
+// chain, pins on the gyroscope) and learn only V: their rollouts stay on the constraint manifold
+// to the rollout tolerance, whatever V they have learned.
+TEST(ConstrainedTask, TheConstrainedModelsTrainOnTheSystemsOwnConstraints) {
+  TempDir dir("runs");
+  const nn::ConstraintSpec chain = make_field_task("chain-pendulum-2")->constraints();
+  EXPECT_EQ(chain.points, 2);
+  EXPECT_EQ(chain.links.size() + chain.anchors.size(), 2u);
+  EXPECT_FALSE(make_field_task("gyroscope")->constraints().pins.empty());
+  for (const auto& [task, model] :
+       {std::pair{"chain-pendulum-2", "chnn"}, std::pair{"chain-pendulum-2", "clnn"},
+        std::pair{"gyroscope", "chnn"}}) {
+    const std::filesystem::path out = dir / (std::string(task) + model);
+    const nlohmann::json m = run_training(tiny(model, out, task));
+    EXPECT_EQ(m["coordinates"], "cartesian") << task << " " << model;
+    EXPECT_TRUE(std::isfinite(m["cartesian_error"].get<double>())) << task << " " << model;
+    EXPECT_EQ(m["cartesian_error_failed"], 0) << task << " " << model;
+    const LoadedRun loaded = load_run(out);
+    const Batch x0 = loaded.run->rollout_states(2);
+    const pc::ConstrainedSystem system = pc::make_constrained_system(
+        std::string(task) == "gyroscope" ? "gyroscope" : "chain_pendulum_2");
+    const std::vector<double> t = system.output_times();
+    const Rollouts r = make_rollouts(system, loaded.run->dynamics(), x0,
+                                     {.t_end = t.back(),
+                                      .points = int(t.size()),
+                                      .rtol = 1e-9,
+                                      .atol = 1e-11,
+                                      .perturbation = 0});
+    for (const Batch& path : r.pred) {
+      EXPECT_LT(system.constraint_values(path).cwiseAbs().maxCoeff(), 1e-5) << task << model;
+    }
+  }
+}
+
 TEST(ConstrainedTask, RefusesAngleModelsWhereHnnHasNoAngles) {
   TempDir dir("runs");
   for (const char* model : {"hnn", "lnn"}) {
