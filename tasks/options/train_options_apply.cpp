@@ -1,5 +1,7 @@
 // apply(): where each option of `hnn train`'s table (train_options.cpp) lands in RunOptions.
 
+#include <fmt/format.h>
+
 #include "tasks/train/loop.h"
 #include "tasks/options/train_options.h"
 
@@ -75,6 +77,11 @@ void apply(const TrainOption& option, const json& v, RunOptions& o) {
       o.task_settings[std::string(option.key)] = v;
       return;
   }
+}
+
+std::string not_applicable(const TrainOption& option, const std::string& task) {
+  if (option.applies_to != AppliesTo::kDataTask || task == "data") return "";
+  return fmt::format("applies to the data task only, not to '{}'", task);
 }
 
 }  // namespace hnn::tasks
