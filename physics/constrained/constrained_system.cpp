@@ -88,19 +88,25 @@ void ConstrainedSystem::add_distance_rows(const double* x, const double* v, Line
   const int d = spec_.dim;
   // One tethered or two-point squared distance: r = x_i - (x_j or anchor), u its velocity.
   const auto add = [&](int i, int j, const double* anchor, double length) {
-    // At most 3 coordinates: on the stack, not the heap (this runs in every field call).
-    Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 3, 1> r(d), u(d);
+    // At most 3 coordinates: on the stack, not the heap (this runs in every field call). Plain
+    // arrays: GCC 12 warns of out-of-bounds AVX-512 loads in Eigen's size-3-at-most vectors.
+    double r[3] = {0, 0, 0}, u[3] = {0, 0, 0};
+    double rr = 0, ru = 0;
     for (int k = 0; k < d; ++k) {
       r[k] = x[i * d + k] - (j >= 0 ? x[j * d + k] : anchor[k]);
       u[k] = v[i * d + k] - (j >= 0 ? v[j * d + k] : 0.0);
+      rr += r[k] * r[k];
+      ru += r[k] * u[k];
     }
-    out.phi[row] = r.squaredNorm() - length * length;
-    out.jv[row] = 2.0 * r.dot(u);
-    out.jacobian.row(row).segment(i * d, d) = 2.0 * r.transpose();
-    out.h.row(row).segment(i * d, d) = 2.0 * u.transpose();
-    if (j >= 0) {
-      out.jacobian.row(row).segment(j * d, d) = -2.0 * r.transpose();
-      out.h.row(row).segment(j * d, d) = -2.0 * u.transpose();
+    out.phi[row] = rr - length * length;
+    out.jv[row] = 2.0 * ru;
+    for (int k = 0; k < d; ++k) {
+      out.jacobian(row, i * d + k) = 2.0 * r[k];
+      out.h(row, i * d + k) = 2.0 * u[k];
+      if (j >= 0) {
+        out.jacobian(row, j * d + k) = -2.0 * r[k];
+        out.h(row, j * d + k) = -2.0 * u[k];
+      }
     }
     ++row;
   };

@@ -56,7 +56,7 @@ TEST(ConstrainedTruth, ConstraintsAndEnergyHoldAlongTheTruthOfEverySystem) {
 }
 
 TEST(ConstrainedField, MultipliersKeepTheSecondDerivativeOfTheConstraintsZero) {
-  for (const std::string& name : {"chain_pendulum_3", "gyroscope", "coupled_pendulums_3"}) {
+  for (const char* name : {"chain_pendulum_3", "gyroscope", "coupled_pendulums_3"}) {
     SCOPED_TRACE(name);
     const ConstrainedSystem system = make_constrained_system(name);
     std::mt19937_64 rng(5);
@@ -82,8 +82,7 @@ TEST(ConstrainedField, MultipliersKeepTheSecondDerivativeOfTheConstraintsZero) {
           -system.inverse_mass_full() * system.potential_gradient(x.data());
       const double with = second_derivative(a.row(r).transpose());
       const double without = second_derivative(free);
-      std::printf("%-20s d2phi/dt2 with multipliers %.1e, without %.1e\n", name.c_str(), with,
-                  without);
+      std::printf("%-20s d2phi/dt2 with multipliers %.1e, without %.1e\n", name, with, without);
       EXPECT_LT(with, 1e-6 * without);
     }
     // On the manifold the projected field of the truth is (v, a).
