@@ -2,8 +2,8 @@
 
 #include <fmt/format.h>
 
-#include "tasks/train/loop.h"
 #include "tasks/options/train_options.h"
+#include "tasks/train/loop.h"
 
 namespace hnn::tasks {
 

@@ -10,8 +10,8 @@
 
 #include "tasks/error.h"
 #include "tasks/options.h"
-#include "tasks/report/json_values.h"
 #include "tasks/options/train_options.h"
+#include "tasks/report/json_values.h"
 
 namespace hnn::tasks {
 

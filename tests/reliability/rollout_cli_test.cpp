@@ -34,7 +34,8 @@ TEST(RolloutCli, TrainsThroughLeapfrogAndRefusesBadSettingsInOneLine) {
 
   const std::vector<BadTrain> cases = {
       {{"train", "spring", "--horizon", "3"},
-       "spring: --horizon, --integrator, --dt and --norm apply to the rollout loss only (add --loss "
+       "spring: --horizon, --integrator, --dt and --norm apply to the rollout loss only (add "
+       "--loss "
        "rollout)\n"},
       {{"train", "pendulum", "--integrator", "midpoint"},
        "pendulum: --horizon, --integrator, --dt and --norm apply to the rollout loss only"},

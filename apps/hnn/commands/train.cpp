@@ -19,8 +19,8 @@
 #include "apps/hnn/commands/summary.h"
 #include "apps/hnn/commands/validators.h"
 #include "tasks/experiments/registry.h"
-#include "tasks/run.h"
 #include "tasks/options/train_options.h"
+#include "tasks/run.h"
 
 namespace hnn::app {
 

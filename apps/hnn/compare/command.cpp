@@ -157,8 +157,8 @@ std::vector<Group> study(const CompareOptions& o) {
   return groups;
 }
 
-// The sweep keys of Adam's steps (tasks/options/fit_options.h, adam_option_given): a protocol's, left
-// out of a row fitted by sampling alone, which takes no steps.
+// The sweep keys of Adam's steps (tasks/options/fit_options.h, adam_option_given): a protocol's,
+// left out of a row fitted by sampling alone, which takes no steps.
 constexpr std::array<const char*, 5> kAdamKeys = {"steps", "batch", "lr", "lr-schedule",
                                                   "checkpoint-every"};
 
@@ -186,7 +186,7 @@ ordered_json row_spec(const Row& row, const CompareOptions& o) {
   for (const auto& [key, value] : row.keys.items()) spec[key] = ordered_json::array({value});
   if (o.steps > 0 && takes_steps(row.fit)) spec["steps"] = {o.steps};  // over the protocol's
   if (row.loss != default_loss(row.task)) spec["loss"] = {row.loss};
-  if (row.fit != "adam") spec["fit"] = {row.fit};           // adam: hnn train's default
+  if (row.fit != "adam") spec["fit"] = {row.fit};  // adam: hnn train's default
   return spec;
 }
 

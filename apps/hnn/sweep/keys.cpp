@@ -1,5 +1,6 @@
-// The spec's keys, `hnn train`'s options as its table declares them (tasks/options/train_options.h): each
-// value checked as JSON by its kind, written as `hnn train` arguments and in run folder names.
+// The spec's keys, `hnn train`'s options as its table declares them
+// (tasks/options/train_options.h): each value checked as JSON by its kind, written as `hnn train`
+// arguments and in run folder names.
 
 #include "apps/hnn/sweep/keys.h"
 

@@ -1,7 +1,7 @@
 #pragma once
 // The keys of `hnn sweep`'s spec: the options of `hnn train` that its table
-// (tasks/options/train_options.h) makes sweep keys, each value checked as JSON, written as `hnn train`
-// arguments and in run folder names.
+// (tasks/options/train_options.h) makes sweep keys, each value checked as JSON, written as `hnn
+// train` arguments and in run folder names.
 
 #include <nlohmann/json.hpp>
 #include <string>

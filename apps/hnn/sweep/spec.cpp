@@ -18,8 +18,8 @@
 #include <stdexcept>
 
 #include "apps/hnn/sweep/keys.h"
-#include "tasks/options/fit_options.h"
 #include "tasks/options.h"
+#include "tasks/options/fit_options.h"
 #include "tasks/run.h"
 
 namespace hnn::app::sweep {
