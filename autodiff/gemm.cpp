@@ -18,9 +18,8 @@ namespace hnn::ad::detail {
 // the 1-thread one (docs/threads.md). So every thread sets it, once, before its first GEMM.
 void init_gemm() {
 #ifdef HNN_HAVE_OPENBLAS
-  thread_local bool done = false;
-  if (done) return;
-  done = true;
+  if (t_gemm_ready) return;
+  t_gemm_ready = true;
   static std::mutex setting;  // OpenBLAS's setter resizes shared buffers: one thread at a time
   std::lock_guard lock(setting);
   openblas_set_num_threads(1);

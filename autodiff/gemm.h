@@ -22,6 +22,8 @@ inline constexpr Eigen::Index kStackedNarrow = kNarrow * 640;
 /// Keeps OpenBLAS from starting threads of its own under the calling thread: gemm calls it on
 /// every thread (Note [One BLAS thread per engine thread] in gemm.cpp).
 void init_gemm();
+/// Whether the calling thread has run init_gemm: checked inline, so a GEMM pays no call for it.
+inline thread_local bool t_gemm_ready = false;
 
 /// Whether a GemmFlopCounter (flop_count.h) is alive, and its count.
 extern std::atomic<bool> g_counting_flops;
@@ -36,7 +38,7 @@ void gemm(const A& a, bool ta, const B& b, bool tb, C&& c, typename A::Scalar be
                (tb ? b.cols() : b.rows()) == k);
   if (g_counting_flops.load(std::memory_order_relaxed)) count_flops(std::uint64_t(2 * m * n * k));
 #ifdef HNN_HAVE_OPENBLAS
-  init_gemm();
+  if (!t_gemm_ready) init_gemm();
   const auto op = [](bool t) { return t ? CblasTrans : CblasNoTrans; };
   const int lda = int(a.outerStride()), ldc = int(c.outerStride());
   int ldb = int(b.outerStride());

@@ -15,9 +15,6 @@ UNIT = r"(ms/step|ms per step|ms a step|GFLOP/s)"
 FIGURE = re.compile(r"\d\s*" + UNIT, re.IGNORECASE)
 TABLE_COLUMN = re.compile(r"^\s*\|.*" + UNIT, re.IGNORECASE)
 MACHINE = re.compile(r"AMD EPYC|\bZen\b|Xeon")
-# Sections being measured again by issue 32's lead, who names the machine there in the rewrite.
-# The test fails once such a section names its machine, so that its entry is removed.
-BEING_REWRITTEN = set()
 
 
 def documents():
@@ -51,14 +48,14 @@ def names_machine(lines):
     return any(MACHINE.search(line) for line in lines)
 
 
-def unattributed(text, skipped_sections=()):
+def unattributed(text):
     """Line numbers of speed figures that name no machine where this module's docstring asks."""
     found = blocks(text)
     missing = []
     for index, (heading, start, lines) in enumerate(found):
         figures = [start + i for i, line in enumerate(lines)
                    if FIGURE.search(line) or TABLE_COLUMN.search(line)]
-        if not figures or heading in skipped_sections:
+        if not figures:
             continue
         first = next(block for block in found if block[0] == heading)
         near = [lines, [heading], first[2]]
@@ -76,19 +73,10 @@ class SpeedFigures(unittest.TestCase):
     def test_every_figure_names_its_machine(self):
         for path in documents():
             name = str(path.relative_to(ROOT))
-            skipped = {heading for file, heading in BEING_REWRITTEN if file == name}
             with self.subTest(path=name):
-                lines = unattributed(path.read_text(encoding="utf-8"), skipped)
+                lines = unattributed(path.read_text(encoding="utf-8"))
                 self.assertEqual(lines, [], f"{name}: the speed figures on lines {lines} name "
                                  "no machine (AMD EPYC, Zen) in their block or section")
-
-    def test_sections_being_rewritten_still_lack_their_machine(self):
-        for name, heading in BEING_REWRITTEN:
-            found = blocks((ROOT / name).read_text(encoding="utf-8"))
-            section = [line for block in found if block[0] == heading for line in block[2]]
-            self.assertTrue(section, f"{name}: no section '{heading}'")
-            self.assertFalse(names_machine(section), f"{name}: '{heading}' names its machine "
-                             "now: remove it from BEING_REWRITTEN")
 
     def test_a_figure_without_a_machine_is_found(self):
         text = ("# Title\n\nIntro.\n\nThe step takes 2.4 ms/step on 2 cores.\n\n"
