@@ -69,7 +69,12 @@ nn::ConstraintSpec model_constraints(const pc::ConstrainedSpec& spec) {
   const auto values = [](const Eigen::VectorXd& v) {
     return std::vector<double>(v.data(), v.data() + v.size());
   };
-  nn::ConstraintSpec c{.points = spec.points, .dim = spec.dim, .mass = spec.mass};
+  nn::ConstraintSpec c{.points = spec.points,
+                       .dim = spec.dim,
+                       .mass = spec.mass,
+                       .links = {},
+                       .anchors = {},
+                       .pins = {}};
   for (const pc::DistanceConstraint& d : spec.distances) c.links.push_back({d.i, d.j, d.length});
   for (const pc::AnchorConstraint& a : spec.anchors) {
     c.anchors.push_back({a.i, values(a.anchor), a.length});

@@ -126,7 +126,7 @@ TEST(ConstrainedTask, TheConstrainedModelsTrainOnTheSystemsOwnConstraints) {
                                       .rtol = 1e-9,
                                       .atol = 1e-11,
                                       .perturbation = 0});
-    for (const Batch& path : r.pred) {
+    for (const auto& path : r.pred) {
       EXPECT_LT(system.constraint_values(path).cwiseAbs().maxCoeff(), 1e-5) << task << model;
     }
   }
