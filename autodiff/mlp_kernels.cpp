@@ -54,6 +54,7 @@ struct PartSpace {
   // Per layer, so that every buffer keeps one shape from step to step (no reallocation):
   // partial weight and bias gradients, hbar_k, and the gradient propagated to layer k.
   std::vector<Matrix<T>> dw, db, hbar, grad;
+  Matrix<T> sums;  // a row of column sums, before it goes into a column of dW_L
   void size_for(int layers) {
     if (int(dw.size()) < layers) {
       dw.resize(std::size_t(layers));
@@ -78,14 +79,24 @@ Node<T>& value_node(const char* op) {
   return record<T>(op, std::span<const Var<T>>(), nullptr);
 }
 
-// The sum of the parts' partial gradients of one parameter, handed on as input `input`.
+// The sum of the parts' partial gradients of one parameter, handed on as input `input`. One
+// part's is swapped into the node, not copied: the node's old buffer (this slot's gradient of the
+// last step, the same shape) becomes the part's next scratch, so nothing is allocated. Two
+// parts' are added in one pass.
 template <typename T>
 void add_reduced(std::vector<PartSpace<T>>& space, int parts,
                  std::vector<Matrix<T>> PartSpace<T>::*partial, int k, int input, GradSink<T>& s,
                  const char* op) {
   Node<T>& g = value_node<T>(op);
-  g.value = (space[0].*partial)[std::size_t(k)];
-  for (int p = 1; p < parts; ++p) g.value += (space[std::size_t(p)].*partial)[std::size_t(k)];
+  const auto part = [&](int p) -> Matrix<T>& {
+    return (space[std::size_t(p)].*partial)[std::size_t(k)];
+  };
+  if (parts == 1) {
+    g.value.swap(part(0));
+  } else {
+    g.value = part(0) + part(1);
+    for (int p = 2; p < parts; ++p) g.value += part(p);
+  }
   s.add(input, Var<T>::of(g));
 }
 
@@ -165,7 +176,11 @@ void up_the_gradient_chain(const MlpLayers<T>& l, const Node<T>& n, const Var<T>
     abar = dbar;
   }
   w.dw[std::size_t(l.count())].resize(abar->cols(), at.columns);
-  column_sums(*abar, w.dw[std::size_t(l.count())].col(j).transpose());
+  // Summed into a contiguous row first: added straight into the column (a stride of m
+  // elements), the sum did not vectorise and cost as much as a GEMM's packing.
+  w.sums.resize(1, abar->cols());
+  column_sums(*abar, w.sums);
+  w.dw[std::size_t(l.count())].col(j) = w.sums.transpose();
 }
 
 // Down the forward chain for rows r: zbar_k in place of hbar_k, dW_k += h_{k-1}^T zbar_k, db_k,

@@ -114,7 +114,8 @@ Var<T> slice_cols(const Var<T>& a, Eigen::Index start, Eigen::Index count) {
         s.add(0, pad_cols(g, static_cast<Eigen::Index>(n.saved[0]), in0(n).cols()));
       });
   node.saved[0] = double(start);
-  node.value = a.value().middleCols(start, count);
+  node.value.resize(a.rows(), count);
+  detail::copy_cols(a.value(), start, node.value, 0, count);
   return Var<T>::of(node);
 }
 
@@ -128,7 +129,7 @@ Var<T> pad_cols(const Var<T>& a, Eigen::Index start, Eigen::Index cols) {
       });
   node.saved[0] = double(start);
   node.value.setZero(a.rows(), cols);
-  node.value.middleCols(start, a.cols()) = a.value();
+  detail::copy_cols(a.value(), 0, node.value, start, a.cols());
   return Var<T>::of(node);
 }
 
@@ -155,7 +156,7 @@ Var<T> concat_span(std::span<const Var<T>> parts) {
   node.value.resize(parts[0].rows(), cols);
   Eigen::Index start = 0;
   for (const Var<T>& p : parts) {
-    node.value.middleCols(start, p.cols()) = p.value();
+    detail::copy_cols(p.value(), 0, node.value, start, p.cols());
     start += p.cols();
   }
   return Var<T>::of(node);

@@ -19,6 +19,23 @@ void column_sums(const X& x, Out&& out) {
   for (Eigen::Index i = 1; i < x.rows(); ++i) out += x.row(i);
 }
 
+/// out's columns = x's columns [start, start + out.cols()), both row-major, as plain loops.
+/// Eigen assigns a block of a row-major matrix row by row, setting up its inner loop each time:
+/// for the one- and two-column slices, pads and joins of the field and integrator steps that
+/// cost about 1 us per 128 rows, several times the copy.
+template <typename T>
+void copy_cols(const Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>& x,
+               Eigen::Index start,
+               Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>& out,
+               Eigen::Index out_start, Eigen::Index count) {
+  const Eigen::Index in_stride = x.cols(), out_stride = out.cols();
+  const T* in = x.data() + start;
+  T* to = out.data() + out_start;
+  for (Eigen::Index i = 0; i < x.rows(); ++i) {
+    for (Eigen::Index c = 0; c < count; ++c) to[i * out_stride + c] = in[i * in_stride + c];
+  }
+}
+
 /// Every row of out = row (1 x cols).
 template <typename Out, typename Row>
 void fill_rows(Out&& out, const Row& row) {

@@ -154,11 +154,14 @@ class Model {
     return nn::mse(dynamics_->time_derivative(x), ad::Var<T>::constant(parts[1]));
   }
 
-  /// One training step: the trainer's loop body.
-  void step(const std::vector<ad::Matrix<T>>& parts) {
+  /// One training step: the trainer's loop body. Returns the nodes it recorded on the tape
+  /// (forward and backward: the step's op count).
+  std::size_t step(const std::vector<ad::Matrix<T>>& parts) {
     ad::TapeScope scope;  // everything this step records is recycled at the closing brace
+    const std::size_t mark = ad::Tape<T>::current().size();
     const ad::Var<T> l = loss(parts);
     ad::grad_into(l, params_, grads_);
+    const std::size_t nodes = ad::Tape<T>::current().size() - mark;
     const auto split = std::ptrdiff_t(ae_.size());
     if (adam_dyn_) {
       adam_main_->step({grads_.begin(), grads_.begin() + split});
@@ -166,6 +169,7 @@ class Model {
     } else {
       adam_main_->step(grads_);
     }
+    return nodes;
   }
 
   /// The mean loss over a whole split, without a graph (chunks of 1000 rows).
@@ -254,20 +258,22 @@ json run(const cmp::Options& o, const cmp::Data& data) {
   cmp::BatchIndices indices(o.seed, parts[0].rows());
   cmp::StepTimer timer(o.steps, o.warmup, o.window);
   std::uint64_t gemm_flops = 0;  // of the first (untimed) step
+  std::size_t nodes = 0;         // of the last step
   for (int step = 0; step < o.steps; ++step) {
     std::optional<ad::GemmFlopCounter> counter;
     if (step == 0) counter.emplace();
     if (o.batch == 0) {
-      model.step(parts);
+      nodes = model.step(parts);
     } else {
       gather(parts, indices, o.batch, batch);
-      model.step(batch);
+      nodes = model.step(batch);
     }
     if (counter) gemm_flops = counter->flops();
     timer.tick(step + 1);
   }
   json result = timer.to_json();
   result["gemm_flops_per_step"] = gemm_flops;
+  result["tape_nodes_per_step"] = nodes;
   result["train_loss"] = model.mean_loss(train);
   result["test_loss"] = model.mean_loss(split_parts(o, data.test_x, data.test_dx));
   result["train_rows"] = parts[0].rows();  // windows, for the rollout loss

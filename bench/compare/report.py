@@ -10,8 +10,9 @@ NAMES = {"hnn": "hnn", "pytorch": "PyTorch", "libtorch": "LibTorch"}
 def summarise(runs, cases, threads_list, peaks=None):
     """One row per case and thread count: each implementation's median ms/step and losses,
     torch/hnn, hnn's GEMM flops per step and their fraction of the FMA peak (`peaks`:
-    {dtype: {threads: GFLOP/s}}), and `slower_than_1` for a side whose time at this thread
-    count is worse than its own at 1 thread."""
+    {dtype: {threads: GFLOP/s}}), hnn's op count per step (the nodes its step records on the
+    tape, forward and backward), and `slower_than_1` for a side whose time at this thread count
+    is worse than its own at 1 thread."""
     rows = []
     for threads in threads_list:
         for case in cases:
@@ -29,6 +30,9 @@ def summarise(runs, cases, threads_list, peaks=None):
                     if flops and peak:
                         row[impl]["gemm_gflop"] = flops[0] / 1e9
                         row[impl]["of_peak"] = flops[0] / (peak * 1e9 * row[impl]["ms"] / 1e3)
+                    nodes = [r["tape_nodes_per_step"] for r in mine if "tape_nodes_per_step" in r]
+                    if nodes:
+                        row[impl]["tape_nodes"] = nodes[0]
             if "hnn" in row:
                 for impl in ("pytorch", "libtorch"):
                     if impl in row:
@@ -102,16 +106,19 @@ def machine_line(meta):
 
 def main_table(rows):
     lines = ["| case | threads | hnn ms/step | PyTorch ms/step | LibTorch ms/step | PyTorch/hnn |"
-             " LibTorch/hnn | hnn GEMM GFLOP/step, of FMA peak | train loss hnn / PyTorch / LibTorch |",
-             "| --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
+             " LibTorch/hnn | hnn GEMM GFLOP/step, of FMA peak | hnn tape nodes/step |"
+             " train loss hnn / PyTorch / LibTorch |",
+             "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
     for row in rows:
         ratio = lambda k: f"{row[k]:.2f}x" if k in row else "-"
         losses = " / ".join(f"{row[i]['train_loss']:.4g}" if i in row else "-" for i in IMPLS)
         h = row.get("hnn", {})
         peak = f"{h['gemm_gflop']:.3g}, {h['of_peak']:.2f}" if "of_peak" in h else "-"
+        nodes = h.get("tape_nodes", "-")
         lines.append(f"| {row['case']} | {row['threads']} | {fmt_ms(row, 'hnn')} | "
                      f"{fmt_ms(row, 'pytorch')} | {fmt_ms(row, 'libtorch')} | "
-                     f"{ratio('pytorch/hnn')} | {ratio('libtorch/hnn')} | {peak} | {losses} |")
+                     f"{ratio('pytorch/hnn')} | {ratio('libtorch/hnn')} | {peak} | {nodes} | "
+                     f"{losses} |")
     return lines
 
 

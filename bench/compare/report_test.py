@@ -1,7 +1,7 @@
 """The tables of report.py on hand-made runs (ctest bench.CompareReport)."""
 import unittest
 
-from report import best_against_best, markdown, summarise
+from report import best_against_best, main_table, markdown, summarise
 
 
 def run(impl, threads, ms, flops=None):
@@ -9,6 +9,7 @@ def run(impl, threads, ms, flops=None):
          "train_loss": 1.0, "test_loss": 2.0}
     if flops is not None:
         r["gemm_flops_per_step"] = flops
+        r["tape_nodes_per_step"] = 32
     return r
 
 
@@ -48,6 +49,11 @@ class ReportTest(unittest.TestCase):
         self.assertIn("AMD EPYC (family 25, model 17", text)
         self.assertIn("3.000 (slower than 1 thread)", text)
         self.assertIn("| c | 2.000 (1) | 5.000 (2) | 2.50x |", text)
+
+    def test_the_main_table_gives_hnn_s_op_count_per_step(self):
+        self.assertEqual(self.row(1)["hnn"]["tape_nodes"], 32)
+        self.assertNotIn("tape_nodes", self.row(1)["pytorch"])
+        self.assertIn("| 2, 10.00 | 32 |", "\n".join(main_table(self.rows)))
 
 
 if __name__ == "__main__":

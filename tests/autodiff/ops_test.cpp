@@ -306,3 +306,29 @@ TEST(ElementwiseThreads, BigOpsGiveTheSameValuesOnOneAndTwoThreads) {
 }
 
 }  // namespace
+
+// Slices, pads and joins copy their columns with plain loops (autodiff/row_kernels.h): exactly
+// the columns, at one column of many rows too.
+TEST(ShapeOps, NarrowSlicesPadsAndJoinsCopyTheirColumnsExactly) {
+  const MatrixD x = random_matrix(130, 3, 7);
+  const VarD v = VarD::constant(x);
+  EXPECT_EQ(ad::slice_cols(v, 1, 1).value(), x.middleCols(1, 1));
+  EXPECT_EQ(ad::slice_cols(v, 1, 2).value(), x.middleCols(1, 2));
+  MatrixD padded = MatrixD::Zero(130, 6);
+  padded.middleCols(2, 3) = x;
+  EXPECT_EQ(ad::pad_cols(v, 2, 6).value(), padded);
+  const MatrixD joined = ad::concat_cols<double>({ad::slice_cols(v, 2, 1), v}).value();
+  EXPECT_EQ(joined.col(0), x.col(2));
+  EXPECT_EQ(joined.rightCols(3), x);
+}
+
+// A broadcast error names the op and both shapes (formatted only when it is thrown).
+TEST(ShapeOps, ShapesThatDoNotBroadcastAreNamedInTheError) {
+  const VarD a = VarD::constant(random_matrix(2, 3, 1)), b = VarD::constant(random_matrix(3, 2, 2));
+  try {
+    (void)ad::add(a, b);
+    FAIL() << "add of 2x3 and 3x2 did not throw";
+  } catch (const ad::Error& e) {
+    EXPECT_EQ(std::string(e.what()), "add: shapes 2x3 and 3x2 cannot be broadcast together");
+  }
+}

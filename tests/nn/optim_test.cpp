@@ -298,3 +298,30 @@ TEST(Adam, GroupsAreCheckedNamingTheGroup) {
   // One parameter in two groups would be updated twice a step.
   EXPECT_THROW(nn::Adam<double>({{{a}, {}}, {{b, a}, {}}}), std::invalid_argument);
 }
+
+// A parameter of 2^15 elements or more is updated in blocks on the engine's threads: the same
+// bits at any thread count, and no allocation after the first step (which starts the workers).
+TEST(Adam, ALargeParameterStepsTheSameAtAnyThreadCountWithoutAllocating) {
+  std::mt19937_64 rng(5);
+  const nn::Matrix<float> start = nn::random_normal<float>(200, 200, rng);
+  std::vector<nn::Matrix<float>> grads;
+  for (int step = 0; step < 4; ++step) grads.push_back(nn::random_normal<float>(200, 200, rng));
+  const auto run = [&](int threads) {
+    ad::set_num_threads(threads);
+    const Var<float> p = Var<float>::leaf(start);
+    nn::Adam<float> adam({p}, {.lr = 1e-2, .weight_decay = 1e-3});
+    for (const nn::Matrix<float>& g : grads) {
+      const std::vector<Var<float>> step_grads{Var<float>::constant(g)};
+      const long count = allocations_in([&] { adam.step(step_grads); });
+#if HNN_COUNTS_ALLOCATIONS
+      if (adam.step_count() > 1) EXPECT_EQ(count, 0) << threads << " thread(s)";
+#endif
+      (void)count;
+    }
+    ad::set_num_threads(2);
+    return nn::Matrix<float>(p.value());
+  };
+  const nn::Matrix<float> one = run(1);
+  EXPECT_NE(one, start);
+  for (int threads : {2, 3}) EXPECT_EQ(run(threads), one) << threads << " threads";
+}
