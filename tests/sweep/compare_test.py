@@ -153,6 +153,36 @@ class Options(CompareCase):
                        "--hamiltonian '2.4*(1 - cos(o)) + v^2'"):
             self.assertIn(option, dhnn[0])
 
+    def test_the_constrained_systems_are_a_study_of_their_own(self):
+        # Finzi et al.'s systems train 8,000 steps a run: a named study, not the default's.
+        result = hnn("compare", "--study", "constrained", "--list", "--out", self.out)
+        self.assertEqual(result.returncode, 0, result.stderr)
+        lines = result.stdout.splitlines()
+        for task in ("chain-pendulum-2", "chain-pendulum-3", "chain-pendulum-5"):
+            for model in ("baseline", "hnn", "lnn", "chnn", "clnn"):
+                self.assertIn(f"{task} {model} rollout: 3 runs", lines)
+        self.assertIn("gyroscope chnn rollout: 3 runs", lines)
+        self.assertTrue(any(l.startswith("gyroscope hnn rollout: skipped: ") for l in lines))
+        # their data efficiency: 10 trajectories, so a batch of all 10 chunks, 2000 steps
+        self.assertIn('chain-pendulum-2 chnn rollout {"settings":{"trajectories":10},"batch":10,'
+                      '"steps":2000}: 3 runs', lines)
+        chnn = [l for l in lines if l.startswith("hnn train chain-pendulum-2 --model chnn ")]
+        self.assertEqual(len(chnn), 6, chnn)  # 3 seeds at their defaults, 3 at 10 trajectories
+        few = [l for l in chnn if "trajectories" in l]
+        self.assertEqual(len(few), 3, chnn)
+        self.assertTrue(all("--batch 10 " in l and "--steps 2000 " in l for l in few), few)
+        self.assertTrue(all("--steps" not in l and "--batch" not in l for l in chnn
+                            if l not in few), chnn)
+        default = hnn("compare", "--list", "--out", self.out)
+        self.assertEqual(default.returncode, 0, default.stderr)
+        self.assertNotIn("chain-pendulum", default.stdout)
+        self.assertNotIn("gyroscope", default.stdout)
+        self.assert_one_line_error(hnn("compare", "--study", "constrained", "--tasks", "spring",
+                                       "--out", self.out), "--tasks excludes --study")
+        self.assert_one_line_error(hnn("compare", "--study", "finzi", "--out", self.out),
+                                   "--study: finzi not in {default,constrained}")
+        self.assertFalse(os.path.exists(self.out))
+
 
 class Report(unittest.TestCase):
     """The report's matching of a peer's protocol settings, on rows made by hand (no runs)."""
@@ -210,6 +240,24 @@ class Report(unittest.TestCase):
         self.assertEqual(self.report.row_label(self.row()), ("three-body", "rollout"))
         self.assertEqual(self.report.headline_of({"headline": {"default": "energy_mse"}},
                                                  {**self.row(), "headline": "x"}), "x")
+
+    def test_finzi_s_chnn_and_clnn_sit_beside_the_constrained_study_s_rows(self):
+        peers = [p for p in read_json(PEERS)["peers"]
+                 if p["peer_model"].startswith(("CHNN", "CLNN"))]
+        self.assertGreaterEqual(len(peers), 10)
+        defaults = lambda p: {"task": p["task"], "model": p["model"], "loss": "rollout",
+                              "keys": {}}
+        few = lambda p: {**defaults(p), "keys": {"settings": {"trajectories": 10}}}
+        for p in peers:
+            with self.subTest(task=p["task"], peer_model=p["peer_model"]):
+                self.assertEqual(p["model"], p["peer_model"][:4].lower())
+                self.assertEqual(p["metric"], "cartesian_error")
+                if p.get("settings"):  # their data efficiency: 10 trajectories only
+                    self.assertTrue(self.report.peer_matches(p, few(p)))
+                    self.assertFalse(self.report.peer_matches(p, defaults(p)))
+                else:  # at the task's defaults (their protocol) only
+                    self.assertTrue(self.report.peer_matches(p, defaults(p)))
+                    self.assertFalse(self.report.peer_matches(p, few(p)))
 
 
 class Tiny(CompareCase):

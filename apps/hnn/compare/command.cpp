@@ -16,9 +16,9 @@
 
 #include "apps/hnn/commands/commands.h"
 #include "apps/hnn/commands/validators.h"
+#include "apps/hnn/compare/studies.h"
 #include "apps/hnn/sweep/keys.h"
 #include "apps/hnn/sweep/launch.h"
-#include "tasks/data/data_files.h"
 #include "tasks/experiments/registry.h"
 #include "tasks/studies/published.h"
 #include "tasks/task.h"
@@ -38,77 +38,11 @@ constexpr int kQuickSteps = 100;
 struct CompareOptions {
   std::vector<std::string> tasks, models, losses, fits;
   int seeds = 3, steps = 0;
-  std::string out;
+  std::string out, study = "default";
   bool quick = false, list = false;
   sweep::LaunchOptions launch;
   std::string command;  // the command line, for the report
 };
-
-// Tasks x models x losses, crossed; in the default study also the protocol of a peer: sweep keys
-// of every run (`keys`) and of the rollout-loss runs (`rollout_keys`), the headline metric and
-// further metrics.json keys for the table.
-struct Group {
-  std::vector<std::string> tasks, models, losses;
-  ordered_json keys = ordered_json::object(), rollout_keys = ordered_json::object();
-  std::string headline;              // "": the peers file's for the task
-  std::vector<std::string> metrics;  // shown on every row of the group
-};
-
-Group crossed(std::vector<std::string> tasks, std::vector<std::string> models,
-              std::vector<std::string> losses) {
-  Group g;
-  g.tasks = std::move(tasks);
-  g.models = std::move(models);
-  g.losses = std::move(losses);
-  return g;
-}
-
-// The default study: the tasks where each family matters, each at its peer's protocol. Names this
-// hnn lacks become skipped rows saying so, not errors.
-std::vector<Group> default_study() {
-  // SRNN's three-body: the HNN paper's system sampled at dt = 1 (its 100 + 32 trajectories of 10
-  // points), trained through leapfrog on windows of 5 points, batch 32 (docs/families.md).
-  Group three_body = crossed({"three-body"}, {"baseline", "hnn"}, {"derivative", "rollout"});
-  three_body.keys["settings"] = {{"setup", "srnn"}};
-  three_body.rollout_keys = {
-      {"integrator", "leapfrog"}, {"horizon", 4}, {"batch", 32}, {"steps", 5000}};
-  three_body.headline = "stretch_position_error";
-  three_body.metrics = {"truth_leapfrog_position_error", "valid_prediction_time"};
-  // Where the rollout loss wins: the spring sampled every time unit, noisy (docs/families.md).
-  Group coarse_spring = crossed({"spring"}, {"baseline", "hnn"}, {"derivative", "rollout"});
-  coarse_spring.keys["settings"] = {{"sample_dt", 1.0}, {"t_end", 6}};
-  coarse_spring.rollout_keys = {{"integrator", "leapfrog"}, {"horizon", 1}};
-  coarse_spring.headline = "stretch_state_mse";
-  coarse_spring.metrics = {"truth_leapfrog_state_mse"};
-  // The D-HNN paper's real pendulum (their analysis notebook): the Lipson file through the data
-  // task, 80/20 in time, width 256, batch 128, 5000 steps at 5e-3; the energy MSE of
-  // H = 2.4 (1 - cos q) + p^2 along the held-out trajectory rolled out from its first state.
-  Group dhnn_real = crossed({"data"}, {"baseline", "hnn", "dhnn"}, {"derivative"});
-  dhnn_real.keys = {{"data", tasks::default_data_path("lipson/real_pend_h_1.txt")},
-                    {"hidden", {256, 256}},
-                    {"batch", 128},
-                    {"steps", 5000},
-                    {"lr", 5e-3},
-                    {"hamiltonian", "2.4*(1 - cos(o)) + v^2"},
-                    {"settings", {{"energy_t_end", 20}, {"rollouts", 15}}}};
-  dhnn_real.headline = "held_out_energy_mse";
-  dhnn_real.metrics = {"valid_prediction_time"};
-  // Finzi et al.'s constrained systems at their protocol, each task's default (through RK4 over
-  // 5-output chunks, L1): the chains in angles for the HNN and LNN, the rest Cartesian only.
-  Group chains = crossed({"chain-pendulum-2", "chain-pendulum-3", "chain-pendulum-5"},
-                         {"baseline", "hnn", "lnn"}, {"rollout"});
-  chains.metrics = {"cartesian_error_floor", "cartesian_error_failed"};
-  Group bodies = crossed({"gyroscope", "rotor", "magnet-pendulum", "coupled-pendulums"},
-                         {"baseline", "hnn"}, {"rollout"});
-  bodies.metrics = chains.metrics;
-  return {crossed({"real-pendulum", "damped-spring"}, {"baseline", "hnn", "dhnn"}, {"derivative"}),
-          dhnn_real,
-          crossed({"double-pendulum"}, {"baseline", "hnn", "lnn"}, {"derivative"}),
-          three_body,
-          coarse_spring,
-          chains,
-          bodies};
-}
 
 // One row of the table: a (task, model, loss) at its protocol's keys, and its runs, or why it
 // does not run.
@@ -135,15 +69,15 @@ void check_names(const std::vector<std::string>& given, const std::vector<std::s
   }
 }
 
-// The study's groups: --tasks x --models x --loss, or the default study narrowed to the --models
-// and --loss given.
+// The study's groups: --tasks x --models x --loss, or the --study narrowed to the --models and
+// --loss given.
 std::vector<Group> study(const CompareOptions& o) {
   if (!o.tasks.empty()) {
     return {crossed(o.tasks, o.models.empty() ? tasks::model_names() : o.models,
                     o.losses.empty() ? std::vector<std::string>{"derivative"} : o.losses)};
   }
   std::vector<Group> groups;
-  for (Group g : default_study()) {
+  for (Group g : named_study(o.study)) {
     const auto keep = [](std::vector<std::string>& names, const std::vector<std::string>& only) {
       if (only.empty()) return;
       std::erase_if(names, [&](const std::string& n) { return !contains(only, n); });
@@ -153,7 +87,8 @@ std::vector<Group> study(const CompareOptions& o) {
     if (!g.models.empty() && !g.losses.empty()) groups.push_back(g);
   }
   if (groups.empty())
-    throw std::invalid_argument("compare: the default study has no runs of those --models/--loss");
+    throw std::invalid_argument(
+        fmt::format("compare: the {} study has no runs of those --models/--loss", o.study));
   return groups;
 }
 
@@ -244,12 +179,14 @@ std::vector<Row> rows_of(const std::vector<Group>& groups, const std::vector<std
       for (const std::string& t : g.tasks)
         for (const std::string& m : g.models)
           for (const std::string& l : g.losses) {
-            if (!seen.insert(t + "\n" + m + "\n" + l + "\n" + f).second) continue;
             Row row{t, m, l, f, g.keys, g.headline, g.metrics, "", {}};
             if (l == "rollout") row.keys.update(g.rollout_keys);
             if (!takes_steps(f))
               for (const char* key : kAdamKeys) row.keys.erase(key);
-            rows.push_back(std::move(row));
+            // A pair twice is one row, unless at another protocol (the constrained study's
+            // 2-chain at 10 trajectories beside its default).
+            if (seen.insert(fmt::format("{}\n{}\n{}\n{}\n{}", t, m, l, f, row.keys.dump())).second)
+              rows.push_back(std::move(row));
           }
   return rows;
 }
@@ -353,9 +290,17 @@ void add_compare_command(CLI::App& app, int argc, char** argv) {
       "and table ours beside the peers' published numbers; see docs/compare.md");
   auto o = std::make_shared<CompareOptions>();
   o->command = command_line(argc, argv);
-  cmd->add_option("--tasks", o->tasks,
-                  "Comma-separated tasks (default: the study of docs/compare.md)")
-      ->delimiter(',');
+  auto* tasks_option =
+      cmd->add_option("--tasks", o->tasks,
+                      "Comma-separated tasks (default: the --study's, docs/compare.md)")
+          ->delimiter(',');
+  cmd->add_option("--study", o->study,
+                  fmt::format("A named study, each task at its peer's protocol: {} (constrained: "
+                              "Finzi et al.'s systems, 8,000 steps a run, hours in all)",
+                              fmt::join(study_names(), ", ")))
+      ->check(CLI::IsMember(study_names()))
+      ->excludes(tasks_option)
+      ->capture_default_str();
   cmd->add_option("--models", o->models,
                   "Comma-separated model families (default: every one hnn has)")
       ->delimiter(',');
