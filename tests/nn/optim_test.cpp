@@ -314,7 +314,9 @@ TEST(Adam, ALargeParameterStepsTheSameAtAnyThreadCountWithoutAllocating) {
       const std::vector<Var<float>> step_grads{Var<float>::constant(g)};
       const long count = allocations_in([&] { adam.step(step_grads); });
 #if HNN_COUNTS_ALLOCATIONS
-      if (adam.step_count() > 1) EXPECT_EQ(count, 0) << threads << " thread(s)";
+      if (adam.step_count() > 1) {
+        EXPECT_EQ(count, 0) << threads << " thread(s)";
+      }
 #endif
       (void)count;
     }
