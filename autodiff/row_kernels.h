@@ -19,7 +19,8 @@ void column_sums(const X& x, Out&& out) {
   for (Eigen::Index i = 1; i < x.rows(); ++i) out += x.row(i);
 }
 
-/// out's columns = x's columns [start, start + out.cols()), both row-major, as plain loops.
+/// out's columns [out_start, out_start + count) = x's columns [start, start + count), both
+/// row-major, as plain loops.
 /// Eigen assigns a block of a row-major matrix row by row, setting up its inner loop each time:
 /// for the one- and two-column slices, pads and joins of the field and integrator steps that
 /// cost about 1 us per 128 rows, several times the copy.

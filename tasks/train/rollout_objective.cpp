@@ -2,9 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include "autodiff/ops.h"
 #include "autodiff/tape.h"
+#include "nn/enum_names.h"
 #include "nn/loss.h"
 #include "tasks/data/dataset.h"
 #include "tasks/error.h"
@@ -28,9 +30,14 @@ ad::Var<T> mean_absolute_error(const ad::Var<T>& a, const ad::Var<T>& b) {
 
 }  // namespace
 
-std::string_view to_string(RolloutNorm norm) { return norm == RolloutNorm::kL1 ? "l1" : "l2"; }
+namespace {
+constexpr nn::NameTable<RolloutNorm, 2> kRolloutNormNames{
+    {{RolloutNorm::kL2, "l2"}, {RolloutNorm::kL1, "l1"}}};
+}  // namespace
 
-std::vector<std::string> rollout_norm_names() { return {"l2", "l1"}; }
+std::string_view to_string(RolloutNorm norm) { return nn::name_of(kRolloutNormNames, norm); }
+
+std::vector<std::string> rollout_norm_names() { return nn::names_of(kRolloutNormNames); }
 
 nlohmann::json RolloutLossConfig::to_json() const {
   if (!rollout) return {{"loss", "derivative"}};
@@ -38,7 +45,7 @@ nlohmann::json RolloutLossConfig::to_json() const {
                       {"integrator", std::string(to_string(integrator))},
                       {"horizon", horizon},
                       {"dt", dt > 0 ? nlohmann::json(dt) : nlohmann::json("sampling interval")}};
-  if (norm == RolloutNorm::kL1) j["norm"] = "l1";  // runs from before the norm trained on l2
+  if (norm != RolloutNorm::kL2) j["norm"] = std::string(to_string(norm));  // older runs: l2
   return j;
 }
 
@@ -67,9 +74,10 @@ RolloutLossConfig rollout_loss_config(const nlohmann::json& s, const std::string
     if (s.contains("dt")) c.dt = s["dt"].get<double>();
     if (s.contains("norm")) {
       const std::string norm = s["norm"].get<std::string>();
-      HNN_TASKS_CHECK(norm == "l2" || norm == "l1", "{}: norm '{}' is not one of l2, l1", task,
-                      norm);
-      c.norm = norm == "l1" ? RolloutNorm::kL1 : RolloutNorm::kL2;
+      const std::optional<RolloutNorm> parsed = nn::find_name(kRolloutNormNames, norm);
+      HNN_TASKS_CHECK(parsed.has_value(), "{}: norm '{}' is not one of {}", task, norm,
+                      nn::join_names(kRolloutNormNames));
+      c.norm = *parsed;
     }
   } catch (const nlohmann::json::exception& e) {
     throw Error(fmt::format("{}: bad rollout-loss settings {}: {}", task, s.dump(), e.what()));
