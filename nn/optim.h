@@ -39,8 +39,10 @@ class Optimizer {
   std::int64_t steps_ = 0;
 };
 
-/// torch.optim.Adam (amsgrad off). Per step t, for each parameter p with gradient g:
-///   g <- g + weight_decay p               (L2 added to the gradient, not decoupled as AdamW)
+/// torch.optim.Adam (amsgrad off), or torch.optim.AdamW with decoupled_weight_decay. Per step
+/// t, for each parameter p with gradient g:
+///   Adam:  g <- g + weight_decay p        (L2 added to the gradient, scaled as the loss's is)
+///   AdamW: p <- p (1 - lr weight_decay)   (decay outside the moments, at the current lr)
 ///   m <- beta1 m + (1 - beta1) g,   v <- beta2 v + (1 - beta2) g^2
 ///   p <- p - lr / (1 - beta1^t) * m / (sqrt(v) / sqrt(1 - beta2^t) + eps)
 /// i.e. p -= lr m_hat / (sqrt(v_hat) + eps), eps added after the square root. Scalar factors are
@@ -51,6 +53,7 @@ struct AdamOptions {
   double beta2 = 0.999;
   double eps = 1e-8;
   double weight_decay = 0;
+  bool decoupled_weight_decay = false;  // AdamW (Loshchilov & Hutter 2019)
 };
 
 /// Parameters with their own Adam settings, as torch.optim.Adam's param_groups: e.g. weight decay

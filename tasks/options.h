@@ -31,6 +31,7 @@ struct TrainConfig {
   double learning_rate = 1e-3;
   double weight_decay = 0.0;
   LrSchedule lr_schedule = LrSchedule::kConstant;
+  OptimizerKind optimizer = OptimizerKind::kAdam;  // where weight_decay acts
   std::vector<int> hidden = {200, 200};
   int record_every = 0;  // loss-curve interval; 0 picks about 100 points
 };
@@ -96,6 +97,7 @@ struct RunOptions {
   std::optional<std::vector<int>> hidden{};  // overrides the preset's widths
   std::optional<double> learning_rate{}, weight_decay{};
   std::optional<LrSchedule> lr_schedule{};
+  std::optional<OptimizerKind> optimizer{};
   std::string data_file{};
   std::string data_sha256{};  // a recorded run's (RunSettings::data_sha256)
   std::vector<int> continued_from{};

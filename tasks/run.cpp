@@ -52,6 +52,7 @@ TrainConfig train_config(const Task& task, const RunOptions& o, const FitConfig&
   if (o.learning_rate) c.learning_rate = *o.learning_rate;
   if (o.weight_decay) c.weight_decay = *o.weight_decay;
   if (o.lr_schedule) c.lr_schedule = *o.lr_schedule;
+  if (o.optimizer) c.optimizer = *o.optimizer;
   return c;
 }
 

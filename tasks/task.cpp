@@ -16,6 +16,12 @@ LoopOptions with_train_config(LoopOptions loop, const TrainConfig& config) {
   return loop;
 }
 
+nn::AdamOptions adam_options(const TrainConfig& config) {
+  return {.lr = config.learning_rate,
+          .weight_decay = config.weight_decay,
+          .decoupled_weight_decay = config.optimizer == OptimizerKind::kAdamW};
+}
+
 void Task::check_task_settings(const nlohmann::json& settings) const {
   HNN_TASKS_CHECK(settings.empty(), "task '{}' has no settings of its own, got {}", name(),
                   settings.dump());

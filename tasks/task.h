@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "nn/dynamics.h"
+#include "nn/optim.h"
 #include "physics/types.h"
 #include "tasks/error.h"
 #include "tasks/options.h"
@@ -53,6 +54,8 @@ int trajectories_to_write(const RolloutRequest& request, int available, std::str
 /// `loop` with the steps, learning-rate schedule and loss-curve interval of `config`: every run
 /// trains with its own settings' (TaskRun::train), whoever made the loop.
 LoopOptions with_train_config(LoopOptions loop, const TrainConfig& config);
+/// Adam's options from the run's: learning rate, weight decay and where it acts.
+nn::AdamOptions adam_options(const TrainConfig& config);
 
 /// One run of a task: its data (built when the run is opened) and its model.
 class TaskRun {

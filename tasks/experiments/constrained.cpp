@@ -109,6 +109,7 @@ class ConstrainedTask : public FieldTask {
             .learning_rate = 3e-3,
             .weight_decay = 1e-4,
             .lr_schedule = LrSchedule::kCosine,
+            .optimizer = OptimizerKind::kAdamW,
             .hidden = {256, 256, 256}};
   }
   RolloutLossConfig default_loss() const override {

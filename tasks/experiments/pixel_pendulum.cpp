@@ -50,6 +50,11 @@ PixelConfig pixel_config(const RunSettings& s) {
   c.batch_size = s.train.batch_size;
   c.learning_rate = s.train.learning_rate;
   c.weight_decay = s.train.weight_decay;
+  HNN_TASKS_CHECK(s.train.optimizer == OptimizerKind::kAdam,
+                  "pixel-pendulum: --optimizer {} does not apply: its autoencoder and latent HNN "
+                  "train with Adam's L2 weight decay on the autoencoder only (task settings "
+                  "weight_decay, dynamics_weight_decay)",
+                  to_string(s.train.optimizer));
   c.hidden = s.train.hidden;
   c.record_every = s.train.record_every;
   pixel::validate(c);

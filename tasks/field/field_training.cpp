@@ -12,9 +12,7 @@ namespace hnn::tasks {
 template <typename T>
 TrainResult train_model(nn::DynamicsModel<T>& model, const Dataset& data, const TrainConfig& config,
                         std::uint64_t seed, LoopOptions loop) {
-  FieldObjective<T> objective(model, data, config.batch_size,
-                              {.lr = config.learning_rate, .weight_decay = config.weight_decay},
-                              seed);
+  FieldObjective<T> objective(model, data, config.batch_size, adam_options(config), seed);
   return train(objective, with_train_config(std::move(loop), config));
 }
 
@@ -92,8 +90,8 @@ TrainResult FieldTraining::train_through_integrator(nn::DynamicsModel<T>& model,
                                                     const RunSettings& s,
                                                     const LoopOptions& loop) const {
   RolloutObjective<T> objective(model, train_windows_, test_windows_, s.train.batch_size,
-                                {.lr = s.train.learning_rate, .weight_decay = s.train.weight_decay},
-                                s.seed, loss_.integrator, substeps_, loss_.norm);
+                                adam_options(s.train), s.seed, loss_.integrator, substeps_,
+                                loss_.norm);
   return tasks::train(objective, with_train_config(loop, s.train));
 }
 

@@ -25,6 +25,7 @@ const char* adam_option_given(const RunOptions& o) {
       {o.batch_size.has_value(), "--batch"},
       {o.learning_rate.has_value(), "--lr"},
       {o.lr_schedule.has_value(), "--lr-schedule"},
+      {o.optimizer.has_value(), "--optimizer"},
       {o.weight_decay.has_value(), "weight decay"},
       {o.checkpoint_every.has_value(), "--checkpoint-every"},
       {o.resume, "--resume"}};

@@ -130,6 +130,17 @@ const TrainOption kOptions[] = {
      .choices = lr_schedule_names,
      .noun = "learning-rate schedule",
      .default_by_task = true},
+    {.name = "optimizer",
+     .kind = ValueKind::kChoice,
+     .help = "adam (weight decay as an L2 term in the gradient, torch.optim.Adam) or adamw "
+             "(decoupled, torch.optim.AdamW); the weight decay itself is each task's",
+     .sweep_rank = 35,
+     .lands = Lands::kOptimizer,
+     .key = "optimizer",
+     .recorded_default = R"("adam")",  // runs from before the choice
+     .choices = optimizer_names,
+     .noun = "optimizer",
+     .default_by_task = true},
     {.name = "data",
      .kind = ValueKind::kFile,
      .help = "The data task's file, or real-pendulum's measured data in its format; with "
@@ -393,5 +404,6 @@ const TrainOption* find_train_option(std::string_view name) {
 
 std::vector<std::string> loss_names() { return {"derivative", "rollout"}; }
 std::vector<std::string> lr_schedule_names() { return nn::names_of(kLrScheduleNames); }
+std::vector<std::string> optimizer_names() { return nn::names_of(kOptimizerNames); }
 
 }  // namespace hnn::tasks

@@ -44,6 +44,9 @@ void apply(const TrainOption& option, const json& v, RunOptions& o) {
     case Lands::kLrSchedule:
       o.lr_schedule = parse_lr_schedule(v.get<std::string>());
       return;
+    case Lands::kOptimizer:
+      o.optimizer = parse_optimizer(v.get<std::string>());
+      return;
     case Lands::kDataFile:
       o.data_file = v.get<std::string>();
       return;

@@ -69,6 +69,8 @@ json recorded_value(const TrainOption& option, const RunSettings& s) {
       return s.train.learning_rate;
     case Lands::kLrSchedule:
       return to_string(s.train.lr_schedule);
+    case Lands::kOptimizer:
+      return to_string(s.train.optimizer);
     case Lands::kDataFile:
       return s.data_file;
     case Lands::kTaskSettings:

@@ -89,6 +89,24 @@ TEST(Adam, ThreeStepsMatchHandComputedValues) {
   }
 }
 
+TEST(Adam, DecoupledWeightDecayMatchesTorchAdamW) {
+  // torch.optim.AdamW(lr=0.1, weight_decay=0.1) in float64 on the same gradients (PyTorch 1.13):
+  // p *= 1 - lr wd before each Adam step, the moments see the gradient alone.
+  const std::vector<std::vector<double>> grads{
+      {0.5, -1.0, 0.0}, {0.1, 0.2, 1e-3}, {-0.3, 0.4, 2.0}};
+  const std::vector<std::vector<double>> expected{
+      {0.890000002, -1.880000001, 0.495},
+      {0.8007959063646517, -1.8100973939804945, 0.41563736973368987},
+      {0.7717166526798616, -1.778572460258351, 0.34757089801850244}};
+  Var<double> p = Var<double>::leaf(MatrixD{{1.0, -2.0, 0.5}});
+  nn::Adam<double> adamw({p}, {.lr = 0.1, .weight_decay = 0.1, .decoupled_weight_decay = true});
+  for (int t = 0; t < 3; ++t) {
+    adamw.step({row({grads[t][0], grads[t][1], grads[t][2]})});
+    expect_row(p.value(), expected[t], 1e-14, "AdamW step " + std::to_string(t + 1));
+  }
+  expect_row(adamw.first_moment(0), {0.0195, -0.023, 0.20009}, 1e-15, "m: the gradients alone");
+}
+
 TEST(Adam, FloatFollowsDouble) {
   Var<double> pd = Var<double>::leaf(MatrixD{{1.0, -2.0}});
   Var<float> pf = Var<float>::leaf(nn::Matrix<float>{{1.0f, -2.0f}});

@@ -74,6 +74,15 @@ std::vector<BadOption> bad_train_options() {
       {{"train", "pixel-pendulum", "--settings", "{\"steps\": 20}"},
        "pixel-pendulum: 'steps' is a training setting: give it as an option (--steps, --batch, "
        "--lr, --hidden), not a task setting"},
+      {{"train", "spring", "--optimizer", "sgd"}, "--optimizer: sgd not in {adam,adamw}"},
+      {{"train", "pixel-pendulum", "--optimizer", "adamw"},
+       "pixel-pendulum: --optimizer adamw does not apply: its autoencoder and latent HNN train "
+       "with Adam's L2 weight decay on the autoencoder only (task settings weight_decay, "
+       "dynamics_weight_decay)"},
+      {{"train", "spring", "--fit", "sampled", "--optimizer", "adam"},
+       "--optimizer does not apply to --fit sampled: it takes no training steps (the hidden "
+       "layers are sampled, the last layer solved); --fit sampled+adam fine-tunes with Adam from "
+       "there"},
       {{"train", "spring", "--bogus"}, "The following argument was not expected: --bogus"},
       {{"train"}, "train needs a TASK (or --resume DIR)"},
   };
@@ -258,6 +267,7 @@ TEST(TrainOptionsTable, TheSweepKeysAreItsRowsInRankOrderAndTheOthersAreRefusedW
   const json values = json::parse(R"({
       "task": "data", "model": "baseline", "seed": 3, "dtype": "float", "preset": "lean",
       "hidden": [8], "steps": 5, "batch": 0, "lr": 0.01, "lr-schedule": "cosine",
+      "optimizer": "adamw",
       "data": "x.csv", "settings": {"threshold": 0.2}, "checkpoint-every": 2, "coords": "q",
       "momenta": "p", "velocities": "v", "derivatives": "dq,dp", "time": "t",
       "trajectory": "traj", "split": "time", "test-fraction": 0.3, "hamiltonian": "q^2",
@@ -331,6 +341,7 @@ TEST(TrainOptionsTable, TheJsonFormReadsBackAsItWasWrittenAndOldRunsGetTheRecord
                             .learning_rate = 0.02,
                             .weight_decay = 1e-4,
                             .lr_schedule = tasks::LrSchedule::kCosine,
+                            .optimizer = tasks::OptimizerKind::kAdamW,
                             .task_settings = {{"loss", "rollout"}, {"horizon", 2}}};
   const json j = tasks::resolve(*task, o).to_json();
   // Its keys: the table's recorded options, and the weight decay (each task's, no option's).

@@ -39,6 +39,7 @@ TEST(ConstrainedTask, HasThePeersProtocolAsItsDefaults) {
   EXPECT_EQ(c.learning_rate, 3e-3);
   EXPECT_EQ(c.weight_decay, 1e-4);
   EXPECT_EQ(c.lr_schedule, LrSchedule::kCosine);
+  EXPECT_EQ(c.optimizer, OptimizerKind::kAdamW);  // their torch.optim.AdamW
   const RolloutLossConfig loss = task->default_loss();
   EXPECT_TRUE(loss.rollout);
   EXPECT_EQ(loss.horizon, 4);

@@ -94,8 +94,8 @@ std::vector<Group> study(const CompareOptions& o) {
 
 // The sweep keys of Adam's steps (tasks/options/fit_options.h, adam_option_given): a protocol's,
 // left out of a row fitted by sampling alone, which takes no steps.
-constexpr std::array<const char*, 5> kAdamKeys = {"steps", "batch", "lr", "lr-schedule",
-                                                  "checkpoint-every"};
+constexpr std::array<const char*, 6> kAdamKeys = {"steps", "batch", "lr", "lr-schedule",
+                                                  "optimizer", "checkpoint-every"};
 
 bool takes_steps(const std::string& fit) { return fit != "sampled"; }
 
