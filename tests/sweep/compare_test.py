@@ -173,6 +173,13 @@ class Options(CompareCase):
         self.assertTrue(all("--batch 10 " in l and "--steps 2000 " in l for l in few), few)
         self.assertTrue(all("--steps" not in l and "--batch" not in l for l in chnn
                             if l not in few), chnn)
+        # --tasks without --loss: each task at its own loss (theirs is the rollout loss)
+        tasks = hnn("compare", "--tasks", "chain-pendulum-2,spring", "--models", "hnn",
+                    "--seeds", "1", "--list", "--out", self.out)
+        self.assertEqual(tasks.returncode, 0, tasks.stderr)
+        self.assertIn("chain-pendulum-2 hnn rollout: 1 runs", tasks.stdout.splitlines())
+        self.assertIn("spring hnn derivative: 1 runs", tasks.stdout.splitlines())
+        self.assertNotIn("--loss", tasks.stdout)
         default = hnn("compare", "--list", "--out", self.out)
         self.assertEqual(default.returncode, 0, default.stderr)
         self.assertNotIn("chain-pendulum", default.stdout)

@@ -69,12 +69,26 @@ void check_names(const std::vector<std::string>& given, const std::vector<std::s
   }
 }
 
+// The loss a task trains with unless told (Task::default_loss): rows of it leave "loss" out, so
+// their run folders keep the names they had. An unknown task (a skipped row) trains none.
+std::string default_loss(const std::string& task) {
+  try {
+    return tasks::make_task(task)->default_loss().rollout ? "rollout" : "derivative";
+  } catch (const tasks::Error&) {
+    return "derivative";
+  }
+}
+
 // The study's groups: --tasks x --models x --loss, or the --study narrowed to the --models and
 // --loss given.
 std::vector<Group> study(const CompareOptions& o) {
   if (!o.tasks.empty()) {
-    return {crossed(o.tasks, o.models.empty() ? tasks::model_names() : o.models,
-                    o.losses.empty() ? std::vector<std::string>{"derivative"} : o.losses)};
+    const std::vector<std::string> models = o.models.empty() ? tasks::model_names() : o.models;
+    if (!o.losses.empty()) return {crossed(o.tasks, models, o.losses)};
+    std::vector<Group> groups;  // each task at the loss it trains with unless told
+    for (const std::string& task : o.tasks)
+      groups.push_back(crossed({task}, models, {default_loss(task)}));
+    return groups;
   }
   std::vector<Group> groups;
   for (Group g : named_study(o.study)) {
@@ -94,20 +108,10 @@ std::vector<Group> study(const CompareOptions& o) {
 
 // The sweep keys of Adam's steps (tasks/options/fit_options.h, adam_option_given): a protocol's,
 // left out of a row fitted by sampling alone, which takes no steps.
-constexpr std::array<const char*, 6> kAdamKeys = {"steps", "batch", "lr", "lr-schedule",
-                                                  "optimizer", "checkpoint-every"};
+constexpr std::array<const char*, 6> kAdamKeys = {"steps",       "batch",     "lr",
+                                                  "lr-schedule", "optimizer", "checkpoint-every"};
 
 bool takes_steps(const std::string& fit) { return fit != "sampled"; }
-
-// The loss a task trains with unless told (Task::default_loss): rows of it leave "loss" out, so
-// their run folders keep the names they had. An unknown task (a skipped row) trains none.
-std::string default_loss(const std::string& task) {
-  try {
-    return tasks::make_task(task)->default_loss().rollout ? "rollout" : "derivative";
-  } catch (const tasks::Error&) {
-    return "derivative";
-  }
-}
 
 // The sweep spec of one row: its task, model, loss and fit, and the seeds (and steps) of the
 // study.
@@ -304,7 +308,9 @@ void add_compare_command(CLI::App& app, int argc, char** argv) {
   cmd->add_option("--models", o->models,
                   "Comma-separated model families (default: every one hnn has)")
       ->delimiter(',');
-  cmd->add_option("--loss", o->losses, "Comma-separated losses: derivative, rollout")
+  cmd->add_option("--loss", o->losses,
+                  "Comma-separated losses: derivative, rollout (default: with --tasks, each "
+                  "task's own; else the --study's)")
       ->delimiter(',');
   cmd->add_option("--fit", o->fits,
                   "Comma-separated fits, an axis of the study: adam, sampled, sampled+adam "
