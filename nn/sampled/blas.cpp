@@ -21,6 +21,11 @@ void dormqr_(const char* side, const char* trans, const int* m, const int* n, co
 void dgelsd_(const int* m, const int* n, const int* nrhs, double* a, const int* lda, double* b,
              const int* ldb, double* s, const double* rcond, int* rank, double* work,
              const int* lwork, int* iwork, int* info);
+void dgeqrt_(const int* m, const int* n, const int* nb, double* a, const int* lda, double* t,
+             const int* ldt, double* work, int* info);
+void dgemqrt_(const char* side, const char* trans, const int* m, const int* n, const int* k,
+              const int* nb, const double* v, const int* ldv, const double* t, const int* ldt,
+              double* c, const int* ldc, double* work, int* info);
 void dtpqrt_(const int* m, const int* n, const int* l, const int* nb, double* a, const int* lda,
              double* b, const int* ldb, double* t, const int* ldt, double* work, int* info);
 void dtpmqrt_(const char* side, const char* trans, const int* m, const int* n, const int* k,
@@ -56,25 +61,63 @@ bool cholesky_upper(ColMat& g) {
   return info == 0;
 }
 
-ColMat qr_apply(ColMat& a, ColMat& b) {
-  const auto m = int(a.rows()), n = int(a.cols()), nrhs = int(b.cols());
-  std::vector<double> tau(static_cast<std::size_t>(n));
-  int info = 0, lwork = -1;
-  double query_qr = 0, query_q = 0;  // workspace queries (lwork -1)
-  dgeqrf_(&m, &n, a.data(), &m, tau.data(), &query_qr, &lwork, &info);
-  dormqr_("L", "T", &m, &nrhs, &n, a.data(), &m, tau.data(), b.data(), &m, &query_q, &lwork, &info);
-  lwork = std::max(1, int(std::max(query_qr, query_q)));
-  std::vector<double> work(static_cast<std::size_t>(lwork));
-  dgeqrf_(&m, &n, a.data(), &m, tau.data(), work.data(), &lwork, &info);
-  if (info == 0) {
-    dormqr_("L", "T", &m, &nrhs, &n, a.data(), &m, tau.data(), b.data(), &m, work.data(), &lwork,
-            &info);
+namespace {
+
+// The QR of the m x n block at a (leading dimension lda) in place, and b <- Q^T b for the m x
+// nrhs block at b (ldb): dgeqrf (nb 0, LAPACK's own block size) or dgeqrt with block size nb.
+void qr_block(double* a, int m, int n, int lda, double* b, int ldb, int nrhs, int nb) {
+  const int k = std::min(m, n);
+  int info = 0;
+  if (nb > 0) {
+    nb = std::min(nb, k);
+    std::vector<double> t(std::size_t(nb) * std::size_t(k));
+    std::vector<double> work(std::size_t(nb) * std::size_t(std::max(n, nrhs)));
+    dgeqrt_(&m, &n, &nb, a, &lda, t.data(), &nb, work.data(), &info);
+    if (info == 0)
+      dgemqrt_("L", "T", &m, &nrhs, &k, &nb, a, &lda, t.data(), &nb, b, &ldb, work.data(), &info);
+  } else {
+    std::vector<double> tau(static_cast<std::size_t>(k));
+    int lwork = -1;
+    double query_qr = 0, query_q = 0;  // workspace queries (lwork -1)
+    dgeqrf_(&m, &n, a, &lda, tau.data(), &query_qr, &lwork, &info);
+    dormqr_("L", "T", &m, &nrhs, &k, a, &lda, tau.data(), b, &ldb, &query_q, &lwork, &info);
+    lwork = std::max(1, int(std::max(query_qr, query_q)));
+    std::vector<double> work(static_cast<std::size_t>(lwork));
+    dgeqrf_(&m, &n, a, &lda, tau.data(), work.data(), &lwork, &info);
+    if (info == 0)
+      dormqr_("L", "T", &m, &nrhs, &k, a, &lda, tau.data(), b, &ldb, work.data(), &lwork, &info);
   }
   if (info != 0) {
-    throw std::runtime_error(
-        fmt::format("sampled fit: LAPACK dgeqrf/dormqr failed (info {})", info));
+    throw std::runtime_error(fmt::format("sampled fit: LAPACK QR failed (info {})", info));
   }
-  return a.topRows(n).triangularView<Eigen::Upper>();
+}
+
+}  // namespace
+
+ColMat qr_apply(ColMat& a, ColMat& b) { return qr_apply_wy(a, b, 0); }
+
+ColMat qr_apply_wy(ColMat& a, ColMat& b, int nb) {
+  qr_block(a.data(), int(a.rows()), int(a.cols()), int(a.rows()), b.data(), int(b.rows()),
+           int(b.cols()), nb);
+  return a.topRows(a.cols()).triangularView<Eigen::Upper>();
+}
+
+ColMat qr_two_halves(ColMat& a, ColMat& b, int nb) {
+  const auto m = int(a.rows()), n = int(a.cols()), half = m / 2, nrhs = int(b.cols());
+  if (half < n || ad::num_threads() < 2) return qr_apply_wy(a, b, nb);
+  // In place: each half is a block of a (and b) with a's leading dimension.
+  openblas_set_num_threads(1);
+  ad::parallel_for(2, [&](int part) {
+    const int first = part == 0 ? 0 : half, rows = part == 0 ? half : m - half;
+    qr_block(a.data() + first, rows, n, m, b.data() + first, int(b.rows()), nrhs, nb);
+  });
+  openblas_set_num_threads(ad::num_threads());
+  ColMat r = a.topRows(n).triangularView<Eigen::Upper>();
+  ColMat t = a.middleRows(half, n).triangularView<Eigen::Upper>();
+  ColMat c = b.topRows(n), d = b.middleRows(half, n);
+  qr_merge_triangle(r, t, c, d);
+  b.topRows(n) = c;
+  return r;
 }
 
 void qr_merge_triangle(ColMat& r, ColMat& t, ColMat& c, ColMat& d) {

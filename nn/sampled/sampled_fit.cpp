@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <memory>
@@ -196,7 +197,11 @@ SampledFitReport fit_sampled(DynamicsModel<T>& model, const Matrix<double>& x,
   std::mt19937_64 rng(config.seed);
   const bool adaptive = config.sampler == HiddenSampler::kAswim;
   const bool baseline = mc.model == ModelKind::kBaseline;
-  Fitted fit = fit_once(mc, xc, dc, config, adaptive ? HiddenSampler::kUswim : config.sampler,
+  DynamicsConfig first = mc;
+  if (adaptive && config.aswim_first_width > 0) {
+    for (Index& w : first.hidden) w = std::min<Index>(w, config.aswim_first_width);
+  }
+  Fitted fit = fit_once(first, xc, dc, config, adaptive ? HiddenSampler::kUswim : config.sampler,
                         nullptr, baseline || adaptive, rng, report);
   if (adaptive) {
     const ColMat approximate = fitted_outputs(fit);

@@ -73,6 +73,9 @@ struct SampledFitConfig {
   double tolerance = 1e-14;
   /// kLsqr's iteration cap.
   int max_iterations = 200;
+  /// kAswim: the width of every hidden layer of the first (U-SWIM) fit, whose outputs weight the
+  /// pairs of the second; 0: the model's own widths.
+  int aswim_first_width = 0;
 };
 
 /// One cutoff of --rcond auto's ladder: the relative field error on the held-out points of the
