@@ -125,7 +125,8 @@ int main(int argc, char** argv) try {
   fit.tolerance = std::stod(arg(argc, argv, "tolerance", fmt::format("{}", fit.tolerance)));
   fit.max_iterations =
       std::stoi(arg(argc, argv, "max-iterations", fmt::format("{}", fit.max_iterations)));
-  fit.aswim_first_width = std::stoi(arg(argc, argv, "first-width", "0"));
+  fit.aswim_first_fraction =
+      std::stod(arg(argc, argv, "first-fraction", fmt::format("{}", fit.aswim_first_fraction)));
   hnn::ad::set_num_threads(std::stoi(arg(argc, argv, "threads", "2")));
 
   std::mt19937_64 rng(fit.seed);

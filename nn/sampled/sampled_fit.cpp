@@ -198,8 +198,9 @@ SampledFitReport fit_sampled(DynamicsModel<T>& model, const Matrix<double>& x,
   const bool adaptive = config.sampler == HiddenSampler::kAswim;
   const bool baseline = mc.model == ModelKind::kBaseline;
   DynamicsConfig first = mc;
-  if (adaptive && config.aswim_first_width > 0) {
-    for (Index& w : first.hidden) w = std::min<Index>(w, config.aswim_first_width);
+  if (adaptive) {
+    for (Index& w : first.hidden)
+      w = std::max<Index>(1, Index(std::lround(double(w) * config.aswim_first_fraction)));
   }
   Fitted fit = fit_once(first, xc, dc, config, adaptive ? HiddenSampler::kUswim : config.sampler,
                         nullptr, baseline || adaptive, rng, report);

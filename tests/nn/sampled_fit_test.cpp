@@ -115,6 +115,18 @@ TEST(SampledFit, EverySamplerFits) {
   EXPECT_LT(aswim, uswim);  // A-SWIM's resampling helps here (3e-4 against 2.4e-3)
 }
 
+// A-SWIM's first fit only weights the pairs of the second: at a fifth of the width (the default)
+// it weights them about as well as at the full width (the peer's), and the model keeps its width.
+TEST(SampledFit, AswimsFirstFitMayBeNarrower) {
+  const Problem test = pendulum(200, 3);
+  const double uswim = field_error(*pendulum_hnn({.sampler = HiddenSampler::kUswim}), test);
+  for (double fraction : {0.2, 1.0}) {
+    auto model = pendulum_hnn({.sampler = HiddenSampler::kAswim, .aswim_first_fraction = fraction});
+    EXPECT_LT(field_error(*model, test), uswim) << "first fit at " << fraction << " of the width";
+    EXPECT_EQ(model->config().hidden, pendulum_hnn({})->config().hidden);
+  }
+}
+
 // A SWIM neuron is built on a pair of data points: its tanh input is -atanh(1/2) at one and
 // +atanh(1/2) at the other (the peer's constants); ELM's are not.
 TEST(SampledFit, SwimNeuronsSitOnPairsOfDataPoints) {
