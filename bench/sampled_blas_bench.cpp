@@ -47,18 +47,8 @@ int main(int argc, char** argv) {
   timed("dgemm", 2 * dw * dw * dw, [&] { sampled::blas_gemm(sq, false, sq, false, c); });
   ColMat b = ColMat::Random(n, 4);
   ColMat r;
-  timed("dgeqrf+dormqr", 2 * dn * dw * dw - 2 * dw * dw * dw / 3,
+  timed("dgeqrt+dgemqrt", 2 * dn * dw * dw - 2 * dw * dw * dw / 3,
         [&] { r = sampled::qr_apply(d, b); });
-  for (int nb : {32, 64, 128}) {
-    ColMat dd = ColMat::Random(n, w), bb = ColMat::Random(n, 4);
-    timed(fmt::format("dgeqrt{}+dgemqrt", nb).c_str(), 2 * dn * dw * dw - 2 * dw * dw * dw / 3,
-          [&] { sampled::qr_apply_wy(dd, bb, nb); });
-  }
-  for (int nb : {0, 64}) {
-    ColMat dd = ColMat::Random(n, w), bb = ColMat::Random(n, 4);
-    timed(fmt::format("two halves nb {}", nb).c_str(), 2 * dn * dw * dw - 2 * dw * dw * dw / 3,
-          [&] { sampled::qr_two_halves(dd, bb, nb); });
-  }
   ColMat t = r, top = b.topRows(w), bottom = b.topRows(w);
   timed("dtpqrt+dtpmqrt", 2 * dw * dw * dw / 3,
         [&] { sampled::qr_merge_triangle(r, t, top, bottom); });

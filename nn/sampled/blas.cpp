@@ -13,11 +13,6 @@
 // LAPACK's Fortran entry points (OpenBLAS carries them; Debian ships no lapacke.h beside it).
 extern "C" {
 void dpotrf_(const char* uplo, const int* n, double* a, const int* lda, int* info);
-void dgeqrf_(const int* m, const int* n, double* a, const int* lda, double* tau, double* work,
-             const int* lwork, int* info);
-void dormqr_(const char* side, const char* trans, const int* m, const int* n, const int* k,
-             const double* a, const int* lda, const double* tau, double* c, const int* ldc,
-             double* work, const int* lwork, int* info);
 void dgelsd_(const int* m, const int* n, const int* nrhs, double* a, const int* lda, double* b,
              const int* ldb, double* s, const double* rcond, int* rank, double* work,
              const int* lwork, int* iwork, int* info);
@@ -61,69 +56,31 @@ bool cholesky_upper(ColMat& g) {
   return info == 0;
 }
 
-namespace {
-
-// The QR of the m x n block at a (leading dimension lda) in place, and b <- Q^T b for the m x
-// nrhs block at b (ldb): dgeqrf (nb 0, LAPACK's own block size) or dgeqrt with block size nb.
-void qr_block(double* a, int m, int n, int lda, double* b, int ldb, int nrhs, int nb) {
-  const int k = std::min(m, n);
+ColMat qr_apply(ColMat& a, ColMat& b) {
+  const auto m = int(a.rows()), n = int(a.cols()), nrhs = int(b.cols()), k = std::min(m, n);
+  // dgeqrt's block size: its panels are recursive (dgeqrt3) and its trailing updates GEMMs of
+  // this depth. 128 took 11.0-11.5 s on the Henon-Heiles D (20000 x 5000) against dgeqrf's
+  // 14.3 s (LAPACK's default block of 32, panels by level-2 Householder steps): docs/sampled.md.
+  const int nb = std::min(128, std::max(k, 1));
+  std::vector<double> t(std::size_t(nb) * std::size_t(std::max(k, 1)));
+  std::vector<double> work(std::size_t(nb) * std::size_t(std::max(n, nrhs)));
   int info = 0;
-  if (nb > 0) {
-    nb = std::min(nb, k);
-    std::vector<double> t(std::size_t(nb) * std::size_t(k));
-    std::vector<double> work(std::size_t(nb) * std::size_t(std::max(n, nrhs)));
-    dgeqrt_(&m, &n, &nb, a, &lda, t.data(), &nb, work.data(), &info);
-    if (info == 0)
-      dgemqrt_("L", "T", &m, &nrhs, &k, &nb, a, &lda, t.data(), &nb, b, &ldb, work.data(), &info);
-  } else {
-    std::vector<double> tau(static_cast<std::size_t>(k));
-    int lwork = -1;
-    double query_qr = 0, query_q = 0;  // workspace queries (lwork -1)
-    dgeqrf_(&m, &n, a, &lda, tau.data(), &query_qr, &lwork, &info);
-    dormqr_("L", "T", &m, &nrhs, &k, a, &lda, tau.data(), b, &ldb, &query_q, &lwork, &info);
-    lwork = std::max(1, int(std::max(query_qr, query_q)));
-    std::vector<double> work(static_cast<std::size_t>(lwork));
-    dgeqrf_(&m, &n, a, &lda, tau.data(), work.data(), &lwork, &info);
-    if (info == 0)
-      dormqr_("L", "T", &m, &nrhs, &k, a, &lda, tau.data(), b, &ldb, work.data(), &lwork, &info);
+  dgeqrt_(&m, &n, &nb, a.data(), &m, t.data(), &nb, work.data(), &info);
+  if (info == 0) {
+    dgemqrt_("L", "T", &m, &nrhs, &k, &nb, a.data(), &m, t.data(), &nb, b.data(), &m, work.data(),
+             &info);
   }
   if (info != 0) {
-    throw std::runtime_error(fmt::format("sampled fit: LAPACK QR failed (info {})", info));
+    throw std::runtime_error(
+        fmt::format("sampled fit: LAPACK dgeqrt/dgemqrt failed (info {})", info));
   }
-}
-
-}  // namespace
-
-ColMat qr_apply(ColMat& a, ColMat& b) { return qr_apply_wy(a, b, 0); }
-
-ColMat qr_apply_wy(ColMat& a, ColMat& b, int nb) {
-  qr_block(a.data(), int(a.rows()), int(a.cols()), int(a.rows()), b.data(), int(b.rows()),
-           int(b.cols()), nb);
-  return a.topRows(a.cols()).triangularView<Eigen::Upper>();
-}
-
-ColMat qr_two_halves(ColMat& a, ColMat& b, int nb) {
-  const auto m = int(a.rows()), n = int(a.cols()), half = m / 2, nrhs = int(b.cols());
-  if (half < n || ad::num_threads() < 2) return qr_apply_wy(a, b, nb);
-  // In place: each half is a block of a (and b) with a's leading dimension.
-  openblas_set_num_threads(1);
-  ad::parallel_for(2, [&](int part) {
-    const int first = part == 0 ? 0 : half, rows = part == 0 ? half : m - half;
-    qr_block(a.data() + first, rows, n, m, b.data() + first, int(b.rows()), nrhs, nb);
-  });
-  openblas_set_num_threads(ad::num_threads());
-  ColMat r = a.topRows(n).triangularView<Eigen::Upper>();
-  ColMat t = a.middleRows(half, n).triangularView<Eigen::Upper>();
-  ColMat c = b.topRows(n), d = b.middleRows(half, n);
-  qr_merge_triangle(r, t, c, d);
-  b.topRows(n) = c;
-  return r;
+  return a.topRows(n).triangularView<Eigen::Upper>();
 }
 
 void qr_merge_triangle(ColMat& r, ColMat& t, ColMat& c, ColMat& d) {
   const auto n = int(r.cols()), nrhs = int(c.cols());
   // The block size of dtpqrt's compact WY form: its trailing updates are GEMMs of this depth.
-  const int nb = std::min(n, 128);
+  const int nb = std::min(n, 128);  // 32, 64 and 256 measured no faster (docs/sampled.md)
   std::vector<double> tf(std::size_t(nb) * std::size_t(n));
   std::vector<double> work(std::size_t(nb) * std::size_t(std::max(n, nrhs)));
   int info = 0;

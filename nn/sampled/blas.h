@@ -27,13 +27,9 @@ void blas_gram(const double* a, Eigen::Index rows, Eigen::Index cols, Eigen::Ind
                double beta);
 /// g = R^T R in place (the upper triangle holds R); false when g is not positive definite.
 bool cholesky_upper(ColMat& g);
-/// a = QR in place (Householder, LAPACK's dgeqrf), then b <- Q^T b; returns R (a.cols() square).
+/// a = QR in place (Householder in compact WY blocks, LAPACK's dgeqrt), then b <- Q^T b; returns
+/// R (a.cols() square).
 ColMat qr_apply(ColMat& a, ColMat& b);
-/// qr_apply by LAPACK's dgeqrt (recursive panels) with block size nb (candidate, measured).
-ColMat qr_apply_wy(ColMat& a, ColMat& b, int nb);
-/// qr_apply as two row halves factored at once, one core each (nb 0: dgeqrf, else dgeqrt),
-/// their triangles merged; b's first a.cols() rows hold Q^T b's (candidate, measured).
-ColMat qr_two_halves(ColMat& a, ColMat& b, int nb);
 /// [r; t] = Q [r'; 0] for upper-triangular n x n r and t (LAPACK's dtpqrt, 2/3 n^3 FLOP
 /// against dgeqrf's 10/3 n^3 on the formed 2n x n stack): r <- r', and [c; d] <- Q^T [c; d]
 /// (n x m each). t and d are destroyed.

@@ -7,7 +7,6 @@
 #include <Eigen/QR>
 #include <Eigen/SVD>
 
-#include "autodiff/parallel.h"
 #include "nn/sampled/blas.h"
 
 namespace hnn::nn::sampled {
@@ -58,25 +57,6 @@ TEST(SampledBlas, ReduceToTriangleKeepsTheLeastSquaresSolution) {
   reduce_to_triangle(t2, tb2);
   EXPECT_EQ(t2, t);
   EXPECT_EQ(tb2, tb);
-}
-
-// Every QR of a tall matrix gives the same least-squares solution from R and Q^T b's head.
-TEST(SampledBlas, TheQrVariantsKeepTheLeastSquaresSolution) {
-  const ColMat a0 = ColMat::Random(300, 40), b0 = ColMat::Random(300, 3);
-  const ColMat want = a0.colPivHouseholderQr().solve(b0);
-  const auto solution = [](const ColMat& r, const ColMat& b) {
-    return ColMat(r.triangularView<Eigen::Upper>().solve(b.topRows(r.cols())));
-  };
-  for (int nb : {0, 8, 32}) {
-    ColMat a = a0, b = b0;
-    const ColMat r = nb == 0 ? qr_apply(a, b) : qr_apply_wy(a, b, nb);
-    EXPECT_LT((solution(r, b) - want).norm(), 1e-12 * want.norm()) << "nb " << nb;
-    ColMat a2 = a0, b2 = b0;
-    ad::set_num_threads(2);  // the halves on two threads
-    const ColMat r2 = qr_two_halves(a2, b2, nb);
-    ad::set_num_threads(1);
-    EXPECT_LT((solution(r2, b2) - want).norm(), 1e-12 * want.norm()) << "halves, nb " << nb;
-  }
 }
 
 }  // namespace
