@@ -1,5 +1,5 @@
-// The table of `hnn train`'s options (train_options.h); apply(), where each lands, is in
-// train_options_apply.cpp.
+// The table of `hnn train`'s options (train_options.h); apply(), where each lands, and the
+// lookups are in train_options_apply.cpp.
 
 #include "tasks/options/train_options.h"
 
@@ -395,15 +395,5 @@ const TrainOption kOptions[] = {
 }  // namespace
 
 std::span<const TrainOption> train_options() { return kOptions; }
-
-const TrainOption* find_train_option(std::string_view name) {
-  for (const TrainOption& option : kOptions)
-    if (option.name == name) return &option;
-  return nullptr;
-}
-
-std::vector<std::string> loss_names() { return {"derivative", "rollout"}; }
-std::vector<std::string> lr_schedule_names() { return nn::names_of(kLrScheduleNames); }
-std::vector<std::string> optimizer_names() { return nn::names_of(kOptimizerNames); }
 
 }  // namespace hnn::tasks

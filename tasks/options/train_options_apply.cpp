@@ -1,7 +1,9 @@
-// apply(): where each option of `hnn train`'s table (train_options.cpp) lands in RunOptions.
+// apply(): where each option of `hnn train`'s table (train_options.cpp) lands in RunOptions;
+// the lookups in the table and the names of its choices.
 
 #include <fmt/format.h>
 
+#include "nn/enum_names.h"
 #include "tasks/options/train_options.h"
 #include "tasks/train/loop.h"
 
@@ -81,6 +83,16 @@ void apply(const TrainOption& option, const json& v, RunOptions& o) {
       return;
   }
 }
+
+const TrainOption* find_train_option(std::string_view name) {
+  for (const TrainOption& option : train_options())
+    if (option.name == name) return &option;
+  return nullptr;
+}
+
+std::vector<std::string> loss_names() { return {"derivative", "rollout"}; }
+std::vector<std::string> lr_schedule_names() { return nn::names_of(kLrScheduleNames); }
+std::vector<std::string> optimizer_names() { return nn::names_of(kOptimizerNames); }
 
 std::string not_applicable(const TrainOption& option, const std::string& task) {
   if (option.applies_to != AppliesTo::kDataTask || task == "data") return "";
