@@ -159,6 +159,8 @@ void Adam<T>::update(std::size_t i, Matrix<T>& p, const Matrix<T>& g) {
   const T bias_correction2_sqrt = T(std::sqrt(1.0 - std::pow(o.beta2, t)));
   const T eps = T(o.eps), decay = T(o.weight_decay);
   const T shrink = T(1.0 - o.lr * o.weight_decay);  // AdamW's, in double as torch's
+  const bool decoupled = decay != T(0) && o.decoupled_weight_decay,
+             l2 = decay != T(0) && !decoupled;
   // Elementwise, so any split into blocks gives the same bits; each block runs m, v and p while
   // they are in cache. One fused expression per buffer: no temporaries, so no allocation.
   const Eigen::Index n = p.size();
@@ -170,11 +172,8 @@ void Adam<T>::update(std::size_t i, Matrix<T>& p, const Matrix<T>& g) {
     auto pa = at(p);
     auto m = at(m_[i]);
     auto v = at(v_[i]);
-    if (decay != T(0) && o.decoupled_weight_decay) {
-      pa *= shrink;
-      m = beta1 * m + (T(1) - beta1) * ga;
-      v = beta2 * v + (T(1) - beta2) * ga.square();
-    } else if (decay != T(0)) {
+    if (decoupled) pa *= shrink;
+    if (l2) {
       m = beta1 * m + (T(1) - beta1) * (ga + decay * pa);
       v = beta2 * v + (T(1) - beta2) * (ga + decay * pa).square();
     } else {

@@ -24,6 +24,10 @@ namespace hnn::tasks {
 inline constexpr int kMaxWidth = 8192;
 inline constexpr int kMaxAdamWidth = 4096;
 
+/// Where Adam's weight decay acts: added to the gradient as an L2 term (torch.optim.Adam), or
+/// decoupled from the moments (torch.optim.AdamW; nn::AdamOptions::decoupled_weight_decay).
+enum class OptimizerKind { kAdam, kAdamW };
+
 /// How a model is trained. Every field can be overridden from the command line.
 struct TrainConfig {
   int steps = 2000;
@@ -42,11 +46,14 @@ enum class Preset { kPaper, kLean };
 
 std::string_view to_string(Dtype dtype);
 std::string_view to_string(Preset preset);
+std::string_view to_string(OptimizerKind optimizer);
 /// Inverses of to_string; throw Error naming the valid values.
 Dtype parse_dtype(std::string_view name);
 Preset parse_preset(std::string_view name);
+OptimizerKind parse_optimizer(std::string_view name);
 std::vector<std::string> dtype_names();
 std::vector<std::string> preset_names();
+std::vector<std::string> optimizer_names();
 std::vector<std::string> model_names();
 /// nn::parse_model_kind, throwing Error.
 nn::ModelKind parse_model(std::string_view name);

@@ -101,7 +101,6 @@ const TrainOption* find_train_option(std::string_view name);
 /// The training losses: dx/dt targets, or the model's field integrated over windows of states.
 std::vector<std::string> loss_names();
 std::vector<std::string> lr_schedule_names();
-std::vector<std::string> optimizer_names();
 
 /// Why `option` does not apply to `task` ("applies to the data task only, not to 'spring'"), or
 /// "" when it does or when the task decides (AppliesTo::kFieldTasks).

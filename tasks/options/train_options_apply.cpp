@@ -92,7 +92,6 @@ const TrainOption* find_train_option(std::string_view name) {
 
 std::vector<std::string> loss_names() { return {"derivative", "rollout"}; }
 std::vector<std::string> lr_schedule_names() { return nn::names_of(kLrScheduleNames); }
-std::vector<std::string> optimizer_names() { return nn::names_of(kOptimizerNames); }
 
 std::string not_applicable(const TrainOption& option, const std::string& task) {
   if (option.applies_to != AppliesTo::kDataTask || task == "data") return "";

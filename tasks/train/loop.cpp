@@ -191,16 +191,6 @@ LrSchedule parse_lr_schedule(std::string_view name) {
                                           nn::join_names(kLrScheduleNames, " or ")));
 }
 
-std::string_view to_string(OptimizerKind optimizer) {
-  return nn::name_of(kOptimizerNames, optimizer);
-}
-
-OptimizerKind parse_optimizer(std::string_view name) {
-  if (const std::optional<OptimizerKind> kind = nn::find_name(kOptimizerNames, name)) return *kind;
-  throw std::invalid_argument(fmt::format("unknown optimizer '{}' (expected {})", name,
-                                          nn::join_names(kOptimizerNames, " or ")));
-}
-
 double lr_factor(LrSchedule schedule, long step, long steps) {
   if (schedule == LrSchedule::kConstant || steps < 1) return 1.0;
   return 0.5 * (1.0 + std::cos(std::numbers::pi * double(step - 1) / double(steps)));

@@ -36,17 +36,6 @@ inline constexpr nn::NameTable<LrSchedule, 2> kLrScheduleNames{{
 std::string_view to_string(LrSchedule schedule);
 /// Inverse of to_string; throws std::invalid_argument naming the valid values.
 LrSchedule parse_lr_schedule(std::string_view name);
-
-/// Where Adam's weight decay acts: added to the gradient as an L2 term (torch.optim.Adam), or
-/// decoupled from the moments (torch.optim.AdamW, nn/optim.h).
-enum class OptimizerKind { kAdam, kAdamW };
-inline constexpr nn::NameTable<OptimizerKind, 2> kOptimizerNames{{
-    {OptimizerKind::kAdam, "adam"},
-    {OptimizerKind::kAdamW, "adamw"},
-}};
-std::string_view to_string(OptimizerKind optimizer);
-/// Inverse of to_string; throws std::invalid_argument naming the valid values.
-OptimizerKind parse_optimizer(std::string_view name);
 /// The factor on the learning rate at `step` (1-based) of `steps`.
 double lr_factor(LrSchedule schedule, long step, long steps);
 
