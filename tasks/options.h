@@ -97,7 +97,7 @@ struct RunOptions {
   std::string task{};
   nn::ModelKind model = nn::ModelKind::kHnn;
   std::uint64_t seed = 0;
-  Dtype dtype = Dtype::kDouble;
+  std::optional<Dtype> dtype{};  // unset: the task's (Task::default_dtype)
   Preset preset = Preset::kPaper;
   int threads = 2;
   std::optional<int> steps{}, batch_size{};

@@ -184,7 +184,7 @@ RunSettings resolve(const Task& task, const RunOptions& o) {
   RunSettings s{.task = task.name(),
                 .model = o.model,
                 .seed = o.seed,
-                .dtype = o.dtype,
+                .dtype = o.dtype.value_or(task.default_dtype()),
                 .preset = o.preset,
                 .threads = o.threads,
                 .train = train_config(task, o, fit),

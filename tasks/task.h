@@ -125,6 +125,8 @@ class Task {
   /// The loss a run trains with when its settings name none (tasks/train/rollout_objective.h);
   /// by default dx/dt targets.
   virtual RolloutLossConfig default_loss() const { return {}; }
+  /// The scalar type a run trains in when --dtype names none; by default double.
+  virtual Dtype default_dtype() const { return Dtype::kDouble; }
   /// Whether --data FILE applies (tasks on measured data).
   virtual bool reads_data_file() const { return false; }
   /// Checks the task's own settings (RunSettings::task_settings); throws Error naming an unknown

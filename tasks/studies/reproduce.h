@@ -15,7 +15,7 @@ namespace hnn::tasks {
 struct ReproduceOptions {
   std::vector<std::string> tasks;  // empty: every task
   int seeds = 1;                   // seeds 0 .. seeds-1, averaged
-  Dtype dtype = Dtype::kDouble;
+  std::optional<Dtype> dtype;      // unset: each task's (Task::default_dtype)
   Preset preset = Preset::kPaper;  // each task's widths, see Task::lean_hidden
   int jobs = 2;                    // runs trained at once (sharing the cores)
   std::optional<int> steps;        // override every task's step count (quick looks)

@@ -44,6 +44,12 @@ TEST(ConstrainedTask, HasThePeersProtocolAsItsDefaults) {
   EXPECT_TRUE(loss.rollout);
   EXPECT_EQ(loss.horizon, 4);
   EXPECT_EQ(loss.norm, RolloutNorm::kL1);
+  // Their float32, unless --dtype names another; the other tasks keep double.
+  RunOptions o = tiny("chnn", "unused");
+  EXPECT_EQ(resolve(*task, o).dtype, Dtype::kFloat);
+  o.dtype = Dtype::kDouble;
+  EXPECT_EQ(resolve(*task, o).dtype, Dtype::kDouble);
+  EXPECT_EQ(make_task("spring")->default_dtype(), Dtype::kDouble);
   // Chunks of 5 states along the constrained truth: on the manifold, each chunk dt apart.
   const Dataset d = make_field_task("chain-pendulum-2")
                         ->build_dataset(RunSettings{.task = "chain-pendulum-2",

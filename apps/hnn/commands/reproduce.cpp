@@ -12,17 +12,15 @@ namespace hnn::app {
 void add_reproduce_command(CLI::App& app) {
   auto* cmd = app.add_subcommand("reproduce", "Train baseline and HNN on every task: Table 1");
   auto options = std::make_shared<tasks::ReproduceOptions>();
-  auto dtype = std::make_shared<std::string>("double"),
-       preset = std::make_shared<std::string>("paper");
+  auto dtype = std::make_shared<std::string>(), preset = std::make_shared<std::string>("paper");
   auto steps = std::make_shared<int>(0);
   cmd->add_option("--tasks", options->tasks, "Comma-separated tasks (default: all)")
       ->delimiter(',');
   cmd->add_option("--seeds", options->seeds, "Seeds per task and model (averaged)")
       ->check(positive_integer())
       ->capture_default_str();
-  cmd->add_option("--dtype", *dtype, "float or double")
-      ->check(CLI::IsMember(tasks::dtype_names()))
-      ->capture_default_str();
+  cmd->add_option("--dtype", *dtype, "float or double (default: each task's own)")
+      ->check(CLI::IsMember(tasks::dtype_names()));
   cmd->add_option("--preset", *preset, "Model widths of every run: paper or lean")
       ->check(CLI::IsMember(tasks::preset_names()))
       ->capture_default_str();
@@ -38,7 +36,7 @@ void add_reproduce_command(CLI::App& app) {
                 "Skip the reversibility report (the table only, sooner)");
   cmd->callback([=] {
     tasks::ReproduceOptions o = *options;
-    o.dtype = tasks::parse_dtype(*dtype);
+    if (!dtype->empty()) o.dtype = tasks::parse_dtype(*dtype);
     o.preset = tasks::parse_preset(*preset);
     if (*steps > 0) o.steps = *steps;
     tasks::reproduce(o);
