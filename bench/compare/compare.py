@@ -49,6 +49,10 @@ _LNN = {"hidden": "600,600,600", "activation": "softplus", "batch": 512, "lr": 1
 _LNN_SMALL = dict(_LNN, hidden="128,128")  # hnn's double-pendulum widths
 _ROLLOUT = {"loss": "rollout", "horizon": 4, "integrator": "leapfrog", "batch": 128, "lr": 1e-3,
             "weight-decay": 1e-4}
+# Finzi et al.'s CHNN protocol (pl_trainer.py): 3 x 256, chunks of 5 states through RK4, L1,
+# AdamW at 3e-3 with weight decay 1e-4, batch 200.
+_CHNN = {"hidden": "256,256,256", "loss": "rollout", "horizon": 4, "integrator": "rk4",
+         "norm": "l1", "optimizer": "adamw", "batch": 200, "lr": 3e-3, "weight-decay": 1e-4}
 PEERS = {
     "realpend-dhnn-f32": ("realpend", "dhnn", "float32", 400, _DHNN),
     "realpend-dhnn-f64": ("realpend", "dhnn", "float64", 400, _DHNN),
@@ -58,6 +62,8 @@ PEERS = {
     "dblpend-lnn-small-f64": ("dblpend", "lnn", "float64", 200, _LNN_SMALL),
     "spring-rollout-f32": ("spring", "hnn", "float32", 200, _ROLLOUT),
     "spring-rollout-f64": ("spring", "hnn", "float64", 200, _ROLLOUT),
+    "chain2-chnn-f32": ("chain2", "chnn", "float32", 30, _CHNN),
+    "chain2-chnn-f64": ("chain2", "chnn", "float64", 30, _CHNN),
 }
 CASES.update(PEERS)
 QUICK = ["spring-hnn-f32", "spring-hnn-f64", "twobody-hnn-f32", "threebody-hnn-f32",
@@ -148,8 +154,10 @@ def prepare(args, hnn, cases, out):
                               "n_test": 750}
             else:
                 path = prep / f"{task}.f64"
-                r = run_json([hnn, "--task", task, "--steps", 2, "--warmup", 1, "--window", 1,
-                              "--save-data", path], env)
+                # The case's model and options: chain2 runs only its CHNN (the data do not
+                # depend on them).
+                r = run_json([hnn, "--task", task, "--model", model, "--steps", 2, "--warmup", 1,
+                              "--window", 1, "--save-data", path] + case_options(name), env)
                 data[task] = {"path": str(path), "n_train": r["n_train"], "n_test": r["n_test"]}
         init = prep / f"{name}.init"
         d = data[task]

@@ -7,11 +7,12 @@
 // --save-init, read by --init), train on the same data file, and draw minibatch rows from the
 // same splitmix64 stream (BatchIndices), so their final losses agree up to rounding.
 //
-// Note [Rollout windows]: the rollout loss (--loss rollout, spring only) trains on windows of
-// horizon + 1 consecutive states of one trajectory: the data file's splits hold 30-point
-// trajectories over t in [0, 3] one after the other (the spring task's stretches), and a
-// window's rows are its start, the horizon states after it and each step's length. Both sides
-// build the windows in the same order and draw window indices from BatchIndices.
+// Note [Rollout windows]: the rollout loss (--loss rollout, spring and chain2) trains on
+// windows of horizon + 1 consecutive states of one trajectory: the data file's splits hold
+// trajectories one after the other (the spring's 30 points over t in [0, 3]; chain2's chunks of
+// 5 points 0.03 apart, Finzi et al.'s), and a window's rows are its start, the horizon states
+// after it and each step's length. Both sides build the windows in the same order and draw
+// window indices from BatchIndices.
 
 #include <algorithm>
 #include <chrono>
@@ -28,14 +29,17 @@ namespace hnn::compare {
 
 /// Command-line options of hnn_train_step and libtorch_step (torch_step.py has the same).
 struct Options {
-  std::string task = "spring";  // spring | twobody | threebody | pixel | realpend | dblpend
-  std::string model = "hnn";    // hnn | baseline | dhnn | lnn
+  std::string task =
+      "spring";               // spring | twobody | threebody | pixel | realpend | dblpend | chain2
+  std::string model = "hnn";  // hnn | baseline | dhnn | lnn | chnn
   std::string dtype = "float32";
   std::vector<long> hidden;             // hidden widths; empty: 200-200 (the HNN paper's)
   std::string activation = "tanh";      // nn::Activation's names (tanh, softplus, ...)
   std::string loss = "field";           // field: MSE of dx/dt; rollout: Note [Rollout windows]
   int horizon = 4;                      // rollout: steps per window
-  std::string integrator = "leapfrog";  // rollout: the step (torch_step.py: leapfrog only)
+  std::string integrator = "leapfrog";  // rollout: the step, leapfrog or rk4
+  std::string norm = "l2";              // rollout: l2 (mean squared) or l1 (mean absolute error)
+  std::string optimizer = "adam";       // adam (L2 in the gradient) or adamw (decoupled)
   int threads = 1;
   int steps = -1;   // default per task (task_defaults)
   int warmup = -1;  // untimed steps; default steps / 10
@@ -59,8 +63,9 @@ inline long task_dim(const std::string& task) {
   if (task == "pixel") return 2 * 28 * 28;
   if (task == "realpend") return 2;
   if (task == "dblpend") return 4;
+  if (task == "chain2") return 8;  // two points in the plane: positions, then velocities
   throw std::invalid_argument("unknown task '" + task +
-                              "' (spring, twobody, threebody, pixel, realpend, dblpend)");
+                              "' (spring, twobody, threebody, pixel, realpend, dblpend, chain2)");
 }
 
 /// hnn's name of a task (tasks::make_task).
@@ -70,12 +75,20 @@ inline std::string task_name(const std::string& task) {
   if (task == "pixel") return "pixel-pendulum";
   if (task == "realpend") return "real-pendulum";
   if (task == "dblpend") return "double-pendulum";
+  if (task == "chain2") return "chain-pendulum-2";
   return task;
 }
 
-/// Trajectories of the spring's data file (Note [Rollout windows]): points each, over [0, t_end].
-constexpr long kSpringPoints = 30;
-constexpr double kSpringTEnd = 3.0;
+/// The trajectories of a rollout task's data file (Note [Rollout windows]): points each, over
+/// [0, t_end].
+struct Stretches {
+  long points;
+  double t_end;
+};
+inline Stretches rollout_stretches(const std::string& task) {
+  if (task == "chain2") return {5, 4 * 0.03};  // the peer's chunks: 4 steps of ChainPendulum's dt
+  return {30, 3.0};                            // the spring task's trajectories
+}
 
 /// "256,256" -> {256, 256}.
 inline std::vector<long> parse_widths(const std::string& text) {
@@ -91,14 +104,27 @@ inline std::vector<long> parse_widths(const std::string& text) {
 
 /// The checks of task_defaults that concern the model and the loss.
 inline void check_model(const Options& o) {
-  if (o.model != "hnn" && o.model != "baseline" && o.model != "dhnn" && o.model != "lnn")
-    throw std::invalid_argument("--model must be hnn, baseline, dhnn or lnn");
+  if (o.model != "hnn" && o.model != "baseline" && o.model != "dhnn" && o.model != "lnn" &&
+      o.model != "chnn")
+    throw std::invalid_argument("--model must be hnn, baseline, dhnn, lnn or chnn");
+  if ((o.model == "chnn") != (o.task == "chain2"))
+    throw std::invalid_argument("--model chnn is chain2's model, and chain2 trains only it");
   if (o.dtype != "float32" && o.dtype != "float64")
     throw std::invalid_argument("--dtype must be float32 or float64");
   if (o.loss != "field" && o.loss != "rollout")
     throw std::invalid_argument("--loss must be field or rollout");
-  if (o.loss == "rollout" && (o.task != "spring" || o.horizon < 1 || o.horizon >= kSpringPoints))
-    throw std::invalid_argument("--loss rollout runs on the spring task, horizon 1..29");
+  const bool rollout_task = o.task == "spring" || o.task == "chain2";
+  if (o.loss == "rollout" &&
+      (!rollout_task || o.horizon < 1 || o.horizon >= rollout_stretches(o.task).points))
+    throw std::invalid_argument(
+        "--loss rollout runs on spring (horizon 1..29) and chain2 (horizon 1..4)");
+  if (o.task == "chain2" && o.loss != "rollout")
+    throw std::invalid_argument("chain2 trains with --loss rollout (Finzi et al.'s chunks)");
+  if (o.integrator != "leapfrog" && o.integrator != "rk4")
+    throw std::invalid_argument("--integrator must be leapfrog or rk4");
+  if (o.norm != "l2" && o.norm != "l1") throw std::invalid_argument("--norm must be l2 or l1");
+  if (o.optimizer != "adam" && o.optimizer != "adamw")
+    throw std::invalid_argument("--optimizer must be adam or adamw");
   if ((o.model == "lnn" || o.model == "dhnn") && o.task == "pixel")
     throw std::invalid_argument("the pixel task trains an hnn or a baseline");
 }
@@ -135,11 +161,11 @@ inline Options parse_options(int argc, char** argv, const char* program) {
     const std::string key = argv[i];
     if (key == "--help" || key == "-h") {
       std::printf(
-          "%s --task spring|twobody|threebody|pixel|realpend|dblpend\n"
-          "  --model hnn|baseline|dhnn|lnn --dtype float32|float64 [--hidden W,W,...]\n"
+          "%s --task spring|twobody|threebody|pixel|realpend|dblpend|chain2\n"
+          "  --model hnn|baseline|dhnn|lnn|chnn --dtype float32|float64 [--hidden W,W,...]\n"
           "  [--activation tanh|softplus|...] [--loss field|rollout --horizon K\n"
-          "  --integrator leapfrog] [--threads N] [--steps N] [--warmup N] [--window N]\n"
-          "  [--batch N] [--seed N]\n"
+          "  --integrator leapfrog|rk4 --norm l2|l1] [--threads N] [--steps N] [--warmup N]\n"
+          "  [--window N] [--batch N] [--seed N] [--optimizer adam|adamw]\n"
           "  [--lr X] [--weight-decay X] [--dynamics-weight-decay X] [--pixel-trials N]\n"
           "  [--data FILE --n-train N --n-test N] [--save-data FILE] [--init FILE]\n"
           "  [--save-init FILE] [--fma-peak float32|float64]\nPrints one JSON line: ms_per_step "
@@ -166,6 +192,10 @@ inline Options parse_options(int argc, char** argv, const char* program) {
       o.horizon = std::stoi(v);
     else if (key == "--integrator")
       o.integrator = v;
+    else if (key == "--norm")
+      o.norm = v;
+    else if (key == "--optimizer")
+      o.optimizer = v;
     else if (key == "--threads")
       o.threads = std::stoi(v);
     else if (key == "--steps")
@@ -330,7 +360,12 @@ inline void add_run_fields(nlohmann::json& j, const Options& o, const std::strin
   j["hidden"] = o.hidden.empty() ? std::vector<long>{200, 200} : o.hidden;
   j["activation"] = o.activation;
   j["loss"] = o.loss;
-  if (o.loss == "rollout") j["horizon"] = o.horizon;
+  if (o.loss == "rollout") {
+    j["horizon"] = o.horizon;
+    j["integrator"] = o.integrator;
+    j["norm"] = o.norm;
+  }
+  j["optimizer"] = o.optimizer;
   j["threads"] = o.threads;
   j["steps"] = o.steps;
   j["warmup"] = o.warmup;

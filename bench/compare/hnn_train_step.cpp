@@ -1,9 +1,9 @@
 // hnn's side of the PyTorch / LibTorch comparison (bench/compare/README.md): trains one task's
 // model with the trainer's step (TapeScope, mse of time_derivative or the rollout loss through
-// tasks::integrator_step, grad, Adam) and prints one JSON line with the median ms/step over
-// timed windows and the final train/test losses.
-// Also writes the data and initial parameters that torch_step.py and libtorch_step load, so all
-// three run the same computation from the same start on the same batches (compare_common.h).
+// tasks::integrator_step, grad, Adam or AdamW) and prints one JSON line with the median ms/step
+// over timed windows and the final train/test losses. Also writes the data and initial parameters
+// that torch_step.py and libtorch_step load, so all three run the same computation from the same
+// start on the same batches (compare_common.h).
 
 #include <Eigen/Core>
 #include <chrono>
@@ -86,8 +86,9 @@ using Parts = std::vector<Batch>;
 
 Parts split_parts(const cmp::Options& o, const cmp::Rows& x, const cmp::Rows& dx) {
   if (o.loss != "rollout") return {to_batch(x), to_batch(dx)};
+  const cmp::Stretches s = cmp::rollout_stretches(o.task);
   const hnn::tasks::RolloutWindows w = hnn::tasks::rollout_windows(
-      hnn::tasks::regular_stretches(to_batch(x), cmp::kSpringPoints, cmp::kSpringTEnd), o.horizon);
+      hnn::tasks::regular_stretches(to_batch(x), int(s.points), s.t_end), o.horizon);
   Parts parts{w.start};
   parts.insert(parts.end(), w.next.begin(), w.next.end());
   parts.insert(parts.end(), w.step.begin(), w.step.end());
@@ -108,6 +109,7 @@ nn::DynamicsConfig dynamics_config(const cmp::Options& o) {
   const auto task = hnn::tasks::make_field_task(cmp::task_name(o.task));
   config.angles = task->angle_coordinates();
   config.input_scale = task->input_scale();
+  if (nn::is_constrained(config.model)) config.constraints = task->constraints();
   return config;
 }
 
@@ -117,6 +119,7 @@ class Model {
  public:
   explicit Model(const cmp::Options& o)
       : rollout_(o.loss == "rollout"),
+        l1_(o.norm == "l1"),
         integrator_(hnn::tasks::parse_rollout_integrator(o.integrator)) {
     std::mt19937_64 rng(o.seed);
     if (o.task == "pixel") {
@@ -136,7 +139,9 @@ class Model {
     params_.insert(params_.end(), dyn_.begin(), dyn_.end());
     // The pixel task's groups (PixelConfig): L2 on the autoencoder only.
     adam_main_ = std::make_unique<nn::Adam<T>>(
-        ae_, nn::AdamOptions{.lr = o.lr, .weight_decay = o.weight_decay});
+        ae_, nn::AdamOptions{.lr = o.lr,
+                             .weight_decay = o.weight_decay,
+                             .decoupled_weight_decay = o.optimizer == "adamw"});
     if (!dyn_.empty()) {
       adam_dyn_ = std::make_unique<nn::Adam<T>>(
           dyn_, nn::AdamOptions{.lr = o.lr, .weight_decay = o.dynamics_weight_decay});
@@ -189,23 +194,36 @@ class Model {
   }
 
   const std::vector<nn::NamedParameter<T>>& named_parameters() const { return named_; }
+  /// The known constraints and masses of a constrained model (torch_peers.Chnn reads them), or
+  /// nullptr.
+  const nn::ConstraintSpec* constraints() const {
+    return dynamics_ && !dynamics_->config().constraints.empty() ? &dynamics_->config().constraints
+                                                                 : nullptr;
+  }
 
  private:
   // RolloutObjective's loss: from the start states, one integrator step per window step, the
-  // MSE of every reached state, averaged over the steps.
+  // MSE (or mean absolute error) of every reached state, averaged over the steps.
   ad::Var<T> rollout_loss(const std::vector<ad::Matrix<T>>& parts) const {
     const std::size_t horizon = (parts.size() - 1) / 2;
     ad::Var<T> x = ad::Var<T>::constant(parts[0]), total;
     for (std::size_t j = 0; j < horizon; ++j) {
       const ad::Var<T> h = ad::Var<T>::constant(parts[1 + horizon + j]);
       x = hnn::tasks::integrator_step(*dynamics_, x, h, integrator_);
-      const ad::Var<T> step_loss = nn::mse(x, ad::Var<T>::constant(parts[1 + j]));
+      const ad::Var<T> target = ad::Var<T>::constant(parts[1 + j]);
+      const ad::Var<T> step_loss = l1_ ? mean_absolute_error(x, target) : nn::mse(x, target);
       total = total.defined() ? total + step_loss : step_loss;
     }
     return total * T(1.0 / double(horizon));
   }
 
-  bool rollout_;
+  // RolloutObjective's: relu(d) + relu(-d), whose derivative is sign(d).
+  static ad::Var<T> mean_absolute_error(const ad::Var<T>& a, const ad::Var<T>& b) {
+    const ad::Var<T> d = ad::sub(a, b);
+    return ad::mean(ad::add(ad::relu(d), ad::relu(ad::neg(d))));
+  }
+
+  bool rollout_, l1_;
   hnn::tasks::RolloutIntegrator integrator_;
   std::unique_ptr<nn::DynamicsModel<T>> dynamics_;
   std::unique_ptr<pixel::PixelModel<T>> pixel_;
@@ -232,6 +250,21 @@ void save_init(const Model<T>& model, const std::string& path) {
   }
   if (!out) throw std::runtime_error("cannot write " + path);
   std::ofstream(path + ".json") << manifest.dump(1) << "\n";
+  if (const nn::ConstraintSpec* spec = model.constraints()) {
+    json links = json::array(), anchors = json::array();
+    for (const nn::Link& l : spec->links) links.push_back({l.i, l.j});
+    for (const nn::Anchor& a : spec->anchors) anchors.push_back({a.i, a.point});
+    json mass = json::array();
+    for (Eigen::Index r = 0; r < spec->mass.rows(); ++r)
+      mass.push_back(std::vector<double>(spec->mass.row(r).begin(), spec->mass.row(r).end()));
+    std::ofstream(path + ".constraints.json") << json{{"points", spec->points},
+                                                      {"dim", spec->dim},
+                                                      {"mass", mass},
+                                                      {"links", links},
+                                                      {"anchors", anchors}}
+                                                     .dump(1)
+                                              << "\n";
+  }
 }
 
 // ---- the timed run ------------------------------------------------------------------------

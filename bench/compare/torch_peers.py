@@ -7,7 +7,10 @@ Imported by torch_step.py. Written the way a PyTorch user would write each peer'
   (the PyTorch 1.13 name of torch.func): per sample, hessian(L) in v, grad(L) in q and
   jacfwd(grad(L) in v) in q, torch.linalg.solve, all under vmap, and loss.backward() through it;
 - the rollout loss: the spring HNN stepped by leapfrog `horizon` times with autograd.grad
-  (create_graph) of the learned H, the MSE of every reached state, backward.
+  (create_graph) of the learned H, the MSE of every reached state, backward;
+- the constrained HNN (Finzi et al. 2020) on the 2-chain pendulum in Cartesian coordinates:
+  V = MLP(positions), dV/dx by autograd.grad, the multipliers from two Cholesky solves per
+  state, 4 RK4 steps through a 5-state chunk, the mean absolute error, AdamW.
 Each mirrors hnn's operation order (compare_common.h, Note [Same computation]).
 """
 import math
@@ -17,7 +20,8 @@ from functorch import grad, hessian, jacfwd, vmap
 
 ACTIVATIONS = {"tanh": torch.tanh, "softplus": torch.nn.functional.softplus,
                "relu": torch.relu, "sigmoid": torch.sigmoid}
-SPRING_POINTS, SPRING_T_END = 30, 3.0  # compare_common.h, Note [Rollout windows]
+# compare_common.h's rollout_stretches (Note [Rollout windows]): points and span of a trajectory.
+STRETCHES = {"spring": (30, 3.0), "chain2": (5, 4 * 0.03)}
 
 
 class DeepMlp(torch.nn.Module):
@@ -92,12 +96,63 @@ class Lnn(torch.nn.Module):
         return torch.cat([x[:, n:], a], 1)
 
 
-def rollout_parts(x, horizon):
-    """Windows of horizon + 1 consecutive states of each 30-point trajectory of x, as hnn's
+class Chnn(torch.nn.Module):
+    """The CHNN as hnn's nn/constrained/mechanics.h writes it, for links |x_i - x_j| = l and
+    anchors |x_i - a| = l with a known mass matrix M (`spec`: hnn_train_step's
+    <init>.constraints.json). Per state, with e_c and w_c = de_c/dt the constraints' vectors and
+    B = D M^-1 D^T: S = B * (e_c . e_c'), K = B * (w_c . e_c' - e_c . w_c'), nu = S^-1 G v,
+    mu = S^-1 (K nu - Gdot v + G M^-1 dV); x' = v - M^-1 D^T (nu e), v' = -M^-1 dV +
+    M^-1 D^T (mu e + nu w)."""
+
+    def __init__(self, spec, hidden, activation):
+        super().__init__()
+        n, d = spec["points"], spec["dim"]
+        self.n, self.d = n, d
+        self.mlp = DeepMlp([n * d, *hidden, 1], activation)
+        blocks = len(spec["links"]) + len(spec["anchors"])
+        incidence, offsets = torch.zeros(blocks, n, dtype=torch.float64), torch.zeros(blocks, d,
+                                                                                      dtype=torch.float64)
+        for c, (i, j) in enumerate(spec["links"]):  # hnn's order: links, then anchors
+            incidence[c, i], incidence[c, j] = 1.0, -1.0
+        for c, (i, point) in enumerate(spec["anchors"], start=len(spec["links"])):
+            incidence[c, i] = 1.0
+            offsets[c] = torch.tensor(point, dtype=torch.float64)
+        minv = torch.linalg.inv(torch.tensor(spec["mass"], dtype=torch.float64))
+        self.register_buffer("incidence", incidence)
+        self.register_buffer("offsets", offsets)
+        self.register_buffer("minv", minv)
+        self.register_buffer("to_velocity", incidence @ minv)  # D M^-1: blocks x points
+        self.register_buffer("gram", incidence @ minv @ incidence.T)  # B
+
+    def forward(self, z, create_graph=True):
+        r, nd = z.shape[0], self.n * self.d
+        x, v = z[:, :nd], z[:, nd:]
+        if not x.requires_grad:
+            x = x.detach().requires_grad_(True)
+        (dv,) = torch.autograd.grad(self.mlp(x).sum(), x, create_graph=create_graph)
+        xs, vs, dvs = (t.reshape(r, self.n, self.d) for t in (x, v, dv))
+        e = torch.einsum("bn,rnk->rbk", self.incidence, xs) - self.offsets
+        w = torch.einsum("bn,rnk->rbk", self.incidence, vs)
+        s = self.gram * torch.bmm(e, e.transpose(1, 2))
+        k = self.gram * (torch.bmm(w, e.transpose(1, 2)) - torch.bmm(e, w.transpose(1, 2)))
+        r1 = (e * w).sum(-1, keepdim=True)
+        r2 = (w * w).sum(-1, keepdim=True) - (
+            e * torch.einsum("bn,rnk->rbk", self.to_velocity, dvs)).sum(-1, keepdim=True)
+        chol = torch.linalg.cholesky(s)
+        nu = torch.cholesky_solve(r1, chol)
+        mu = torch.cholesky_solve(torch.bmm(k, nu) - r2, chol)
+        x_dot = vs - torch.einsum("bn,rbk->rnk", self.to_velocity, nu * e)
+        v_dot = (-torch.einsum("nm,rmk->rnk", self.minv, dvs)
+                 + torch.einsum("bn,rbk->rnk", self.to_velocity, mu * e + nu * w))
+        return torch.cat([x_dot.reshape(r, nd), v_dot.reshape(r, nd)], 1)
+
+
+def rollout_parts(x, horizon, task="spring"):
+    """Windows of horizon + 1 consecutive states of each trajectory of x (STRETCHES), as hnn's
     tasks::rollout_windows(regular_stretches(...)): [start, next_1..next_K, step_1..step_K]."""
-    n = SPRING_POINTS
-    t = [SPRING_T_END * i / (n - 1) for i in range(n)]  # physics::linspace
-    t[-1] = SPRING_T_END
+    n, t_end = STRETCHES[task]
+    t = [t_end * i / (n - 1) for i in range(n)]  # physics::linspace
+    t[-1] = t_end
     rows = [s + i for s in range(0, x.shape[0] - n + 1, n) for i in range(n - horizon)]
     idx = torch.tensor(rows, dtype=torch.long)
     parts = [x.index_select(0, idx)]
@@ -120,13 +175,27 @@ def leapfrog(field, x, h):
     return torch.cat([q1, p1], 1)
 
 
-def rollout_loss(field, parts, create_graph=True):
-    """RolloutObjective's loss: one step per window step, the MSE of every reached state,
-    averaged over the steps."""
+def rk4(field, x, h):
+    """tasks/integrate/integrator_step.cpp's classical RK4 (h a column)."""
+    half = h * 0.5
+    k1 = field(x)
+    k2 = field(x + half * k1)
+    k3 = field(x + half * k2)
+    k4 = field(x + h * k3)
+    return x + (h * (1.0 / 6.0)) * (k1 + 2 * k2 + 2 * k3 + k4)
+
+
+INTEGRATORS = {"leapfrog": leapfrog, "rk4": rk4}
+
+
+def rollout_loss(field, parts, create_graph=True, integrator="leapfrog", norm="l2"):
+    """RolloutObjective's loss: one step per window step, the MSE (norm l1: the mean absolute
+    error) of every reached state, averaged over the steps."""
     horizon = (len(parts) - 1) // 2
-    x, total = parts[0], None
+    x, total, step = parts[0], None, INTEGRATORS[integrator]
     for j in range(horizon):
-        x = leapfrog(lambda s: field(s, create_graph), x, parts[1 + horizon + j])
-        step_loss = (x - parts[1 + j]).pow(2).mean()
+        x = step(lambda s: field(s, create_graph), x, parts[1 + horizon + j])
+        d = x - parts[1 + j]
+        step_loss = d.abs().mean() if norm == "l1" else d.pow(2).mean()
         total = step_loss if total is None else total + step_loss
     return total * (1.0 / horizon)

@@ -11,7 +11,9 @@ a 200-200 tanh MLP to a scalar H (HNN) or to dx/dt (baseline); pixel: the residu
 autoencoder 1568-200-200-200-2 and back with a 2-200-200-1 HNN (or 2-200-200-2 baseline) on
 the latent, loss mean(ae + cc + 0.1 hnn). Adam, lr 1e-3. The peers' cases (torch_peers.py):
 realpend with --model dhnn (batch 128, lr 5e-3), dblpend with --model lnn (batch 512), and the
-spring HNN with --loss rollout (leapfrog, batch 128), at the widths of --hidden.
+spring HNN with --loss rollout (leapfrog, batch 128), and chain2 with --model chnn (the
+2-chain pendulum's CHNN through RK4 chunks, L1, AdamW; its constraints and masses from
+<init>.constraints.json), at the widths of --hidden.
 
 Run with Debian's interpreter (/usr/bin/python3 sees python3-torch). Exits 0 with a message
 when torch is missing.
@@ -31,7 +33,7 @@ except ImportError as error:  # the harness skips PyTorch when it is absent
     sys.exit(0)
 
 DIMS = {"spring": 2, "twobody": 8, "threebody": 12, "pixel": 2 * 28 * 28, "realpend": 2,
-        "dblpend": 4}
+        "dblpend": 4, "chain2": 8}
 HNN_WEIGHT = 0.1
 
 
@@ -39,9 +41,11 @@ def task_defaults(a):
     """The per-task defaults of compare_common.h's task_defaults."""
     spring, pixel = a.task == "spring", a.task == "pixel"
     peer = a.task in ("realpend", "dblpend")
-    if a.loss == "rollout" and (not spring or not 1 <= a.horizon < torch_peers.SPRING_POINTS
-                                or a.integrator != "leapfrog"):
-        sys.exit("torch_step.py: --loss rollout runs the spring task, leapfrog, horizon 1..29")
+    stretch = torch_peers.STRETCHES.get(a.task)
+    if a.loss == "rollout" and (stretch is None or not 1 <= a.horizon < stretch[0]):
+        sys.exit("torch_step.py: --loss rollout runs spring (horizon 1..29) and chain2 (1..4)")
+    if (a.model == "chnn") != (a.task == "chain2") or (a.task == "chain2" and a.loss != "rollout"):
+        sys.exit("torch_step.py: chain2 trains --model chnn with --loss rollout, and only it")
     if a.batch is None:
         a.batch = (128 if a.task == "realpend" or a.loss == "rollout" else 512
                    if a.task == "dblpend" else 0 if spring else 600 if a.task == "threebody"
@@ -232,6 +236,11 @@ def build_model(a, dtype):
         model = torch_peers.Dhnn(DIMS[a.task], hidden, a.activation)
     elif a.model == "lnn":
         model = torch_peers.Lnn(DIMS[a.task], hidden, a.activation)
+    elif a.model == "chnn":
+        if not a.init:
+            sys.exit("torch_step.py: --model chnn needs --init (its constraints come beside it)")
+        with open(a.init + ".constraints.json") as f:
+            model = torch_peers.Chnn(json.load(f), hidden, a.activation)
     elif a.hidden or a.activation != "tanh":
         sys.exit("torch_step.py: --hidden and --activation apply to dhnn and lnn")
     else:
@@ -239,25 +248,28 @@ def build_model(a, dtype):
     model = model.to(dtype)
     groups = [{"params": model.parameters(), "weight_decay": a.weight_decay}]
     if a.loss == "rollout":
-        return model, groups, lambda p, graph=True: torch_peers.rollout_loss(model, p, graph)
+        return model, groups, lambda p, graph=True: torch_peers.rollout_loss(
+            model, p, graph, a.integrator, a.norm)
     return model, groups, lambda p, graph=True: (model(p[0], graph) - p[1]).pow(2).mean()
 
 
 def split_parts(a, x, dx):
-    return torch_peers.rollout_parts(x, a.horizon) if a.loss == "rollout" else [x, dx]
+    return torch_peers.rollout_parts(x, a.horizon, a.task) if a.loss == "rollout" else [x, dx]
 
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--task", choices=sorted(DIMS), default="spring")
-    ap.add_argument("--model", choices=["hnn", "baseline", "dhnn", "lnn"], default="hnn")
+    ap.add_argument("--model", choices=["hnn", "baseline", "dhnn", "lnn", "chnn"], default="hnn")
     ap.add_argument("--dtype", choices=["float32", "float64"], default="float32")
     ap.add_argument("--hidden", type=lambda t: [int(w) for w in t.split(",")],
                     help="hidden widths, e.g. 256,256 (dhnn, lnn)")
     ap.add_argument("--activation", choices=sorted(torch_peers.ACTIVATIONS), default="tanh")
     ap.add_argument("--loss", choices=["field", "rollout"], default="field")
     ap.add_argument("--horizon", type=int, default=4)
-    ap.add_argument("--integrator", default="leapfrog")
+    ap.add_argument("--integrator", choices=sorted(torch_peers.INTEGRATORS), default="leapfrog")
+    ap.add_argument("--norm", choices=["l2", "l1"], default="l2")
+    ap.add_argument("--optimizer", choices=["adam", "adamw"], default="adam")
     ap.add_argument("--threads", type=int, default=1)
     for name in ("steps", "warmup", "window", "batch", "n-train", "n-test"):
         ap.add_argument("--" + name, type=int)
@@ -278,7 +290,7 @@ def main():
     model, groups, loss_fn = build_model(a, dtype)
     if a.init:
         load_init(model, a.init)
-    opt = torch.optim.Adam(groups, lr=a.lr)
+    opt = (torch.optim.AdamW if a.optimizer == "adamw" else torch.optim.Adam)(groups, lr=a.lr)
     train, test = split_parts(a, x_tr, dx_tr), split_parts(a, x_te, dx_te)
     rows = train[0].shape[0]
     idx = None if a.batch == 0 else batch_indices(a.seed, rows, a.steps * a.batch)
