@@ -116,7 +116,8 @@ class ConstrainedTask : public FieldTask {
     return {.rollout = true,
             .horizon = kChunkOutputs - 1,
             .integrator = RolloutIntegrator::kRk4,
-            .norm = RolloutNorm::kL1};
+            .norm = RolloutNorm::kL1,
+            .minibatches = RowSampler::Draw::kEpochs};  // their DataLoader(shuffle=True)
   }
   // Their pl_trainer trains and evaluates in float32 (datasets.py casts the trajectories with
   // .float()); float runs the 2-chain's default run in 304 s on 2 threads against 807 s in double,

@@ -91,7 +91,7 @@ TrainResult FieldTraining::train_through_integrator(nn::DynamicsModel<T>& model,
                                                     const LoopOptions& loop) const {
   RolloutObjective<T> objective(model, train_windows_, test_windows_, s.train.batch_size,
                                 adam_options(s.train), s.seed, loss_.integrator, substeps_,
-                                loss_.norm);
+                                loss_.norm, loss_.minibatches);
   return tasks::train(objective, with_train_config(loop, s.train));
 }
 

@@ -311,6 +311,16 @@ const TrainOption kOptions[] = {
      .key = "norm",
      .choices = rollout_norm_names,
      .noun = "norm"},
+    {.name = "minibatches",
+     .kind = ValueKind::kChoice,
+     .help = "How the rollout loss's batches draw windows: independent (uniform, with "
+             "replacement; the default) or epochs (shuffled epochs; the constrained tasks')",
+     .group = kRolloutGroup,
+     .sweep_rank = 36,
+     .applies_to = AppliesTo::kFieldTasks,
+     .key = "minibatches",
+     .choices = minibatch_draw_names,
+     .noun = "minibatch draw"},
     {.name = "fit",
      .kind = ValueKind::kChoice,
      .help = "adam, sampled (hidden layers sampled from the data, the last layer by least "

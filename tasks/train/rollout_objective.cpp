@@ -39,6 +39,13 @@ std::string_view to_string(RolloutNorm norm) { return nn::name_of(kRolloutNormNa
 
 std::vector<std::string> rollout_norm_names() { return nn::names_of(kRolloutNormNames); }
 
+namespace {
+constexpr nn::NameTable<RowSampler::Draw, 2> kMinibatchDrawNames{
+    {{RowSampler::Draw::kWithReplacement, "independent"}, {RowSampler::Draw::kEpochs, "epochs"}}};
+}  // namespace
+
+std::vector<std::string> minibatch_draw_names() { return nn::names_of(kMinibatchDrawNames); }
+
 nlohmann::json RolloutLossConfig::to_json() const {
   if (!rollout) return {{"loss", "derivative"}};
   nlohmann::json j = {{"loss", "rollout"},
@@ -46,11 +53,14 @@ nlohmann::json RolloutLossConfig::to_json() const {
                       {"horizon", horizon},
                       {"dt", dt > 0 ? nlohmann::json(dt) : nlohmann::json("sampling interval")}};
   if (norm != RolloutNorm::kL2) j["norm"] = std::string(to_string(norm));  // older runs: l2
+  if (minibatches != RowSampler::Draw::kWithReplacement)  // older runs: independent
+    j["minibatches"] = std::string(nn::name_of(kMinibatchDrawNames, minibatches));
   return j;
 }
 
 const std::vector<std::string>& rollout_setting_names() {
-  static const std::vector<std::string> names = {"loss", "horizon", "integrator", "dt", "norm"};
+  static const std::vector<std::string> names = {"loss", "horizon",    "integrator",
+                                                 "dt",   "norm",       "minibatches"};
   return names;
 }
 
@@ -79,13 +89,21 @@ RolloutLossConfig rollout_loss_config(const nlohmann::json& s, const std::string
                       nn::join_names(kRolloutNormNames));
       c.norm = *parsed;
     }
+    if (s.contains("minibatches")) {
+      const std::string draw = s["minibatches"].get<std::string>();
+      const auto parsed = nn::find_name(kMinibatchDrawNames, draw);
+      HNN_TASKS_CHECK(parsed.has_value(), "{}: minibatches '{}' is not one of {}", task, draw,
+                      nn::join_names(kMinibatchDrawNames));
+      c.minibatches = *parsed;
+    }
   } catch (const nlohmann::json::exception& e) {
     throw Error(fmt::format("{}: bad rollout-loss settings {}: {}", task, s.dump(), e.what()));
   }
   HNN_TASKS_CHECK(c.rollout || (!s.contains("horizon") && !s.contains("integrator") &&
-                                !s.contains("dt") && !s.contains("norm")),
-                  "{}: --horizon, --integrator, --dt and --norm apply to the rollout loss only "
-                  "(add --loss rollout)",
+                                !s.contains("dt") && !s.contains("norm") &&
+                                !s.contains("minibatches")),
+                  "{}: --horizon, --integrator, --dt, --norm and --minibatches apply to the "
+                  "rollout loss only (add --loss rollout)",
                   task);
   HNN_TASKS_CHECK(c.horizon >= 1, "{}: horizon must be at least 1 step, got {}", task, c.horizon);
   HNN_TASKS_CHECK(!s.contains("dt") || (c.dt > 0 && std::isfinite(c.dt)),
@@ -144,12 +162,13 @@ template <typename T>
 RolloutObjective<T>::RolloutObjective(nn::DynamicsModel<T>& model, RolloutWindows train,
                                       RolloutWindows test, Eigen::Index batch_size,
                                       const nn::AdamOptions& adam, std::uint64_t seed,
-                                      RolloutIntegrator integrator, int substeps, RolloutNorm norm)
+                                      RolloutIntegrator integrator, int substeps, RolloutNorm norm,
+                                      RowSampler::Draw minibatches)
     : model_(model),
       train_(std::move(train)),
       test_(std::move(test)),
       adam_(adam),
-      sampler_(train_.count(), batch_size, RowSampler::Draw::kWithReplacement, seed),
+      sampler_(train_.count(), batch_size, minibatches, seed),
       integrator_(integrator),
       substeps_(substeps),
       norm_(norm),

@@ -39,8 +39,12 @@ enum class RolloutNorm { kL2, kL1 };
 std::string_view to_string(RolloutNorm norm);
 std::vector<std::string> rollout_norm_names();
 
+/// How the rollout loss's minibatches draw windows: "independent" (uniform, with replacement,
+/// as the paper's tasks draw rows) or "epochs" (shuffled epochs, Finzi et al.'s DataLoader).
+std::vector<std::string> minibatch_draw_names();
+
 /// How a run trains: its task settings "loss" (derivative or rollout), "horizon", "integrator",
-/// "dt" and "norm", the same keys on every task that learns a field from states. Parsed once,
+/// "dt", "norm" and "minibatches", the same keys on every task that learns a field from states. Parsed once,
 /// where a run's settings are resolved (tasks/run.cpp), into RunSettings::loss.
 struct RolloutLossConfig {
   bool rollout = false;  ///< "loss": "rollout" (else dx/dt targets)
@@ -48,8 +52,9 @@ struct RolloutLossConfig {
   RolloutIntegrator integrator = RolloutIntegrator::kRk4;
   double dt = 0;  ///< the step; 0: one step per sampling interval
   RolloutNorm norm = RolloutNorm::kL2;
+  RowSampler::Draw minibatches = RowSampler::Draw::kWithReplacement;  ///< or kEpochs
 
-  /// {"loss", "integrator", "horizon", "dt"} as metrics.json reports them.
+  /// {"loss", "integrator", "horizon", "dt", ...} as metrics.json reports them.
   nlohmann::json to_json() const;
 };
 
@@ -73,7 +78,8 @@ class RolloutObjective : public Objective<T> {
   RolloutObjective(nn::DynamicsModel<T>& model, RolloutWindows train, RolloutWindows test,
                    Eigen::Index batch_size, const nn::AdamOptions& adam, std::uint64_t seed,
                    RolloutIntegrator integrator = RolloutIntegrator::kRk4, int substeps = 1,
-                   RolloutNorm norm = RolloutNorm::kL2);
+                   RolloutNorm norm = RolloutNorm::kL2,
+                   RowSampler::Draw minibatches = RowSampler::Draw::kWithReplacement);
 
   nn::Module<T>& model() override { return model_; }
   std::vector<nn::AdamGroup<T>> parameter_groups() const override {

@@ -1,5 +1,6 @@
 #include "tasks/train/sampler.h"
 
+#include <algorithm>
 #include <numeric>
 #include <sstream>
 
@@ -15,14 +16,27 @@ RowSampler::RowSampler(Eigen::Index rows, Eigen::Index batch, Draw draw, std::ui
   full_ = draw == Draw::kWithReplacement && (batch == 0 || batch == rows);
   if (full_) return;
   batch_.resize(std::size_t(batch == 0 ? rows : batch));
-  if (draw == Draw::kWithoutReplacement) {
+  if (draw != Draw::kWithReplacement) {
     order_.resize(std::size_t(rows));
     std::iota(order_.begin(), order_.end(), Eigen::Index(0));
+    epoch_next_ = order_.size();  // the first draw starts an epoch
   }
 }
 
 void RowSampler::next() {
   if (full_) return;
+  if (draw_ == Draw::kEpochs) {
+    if (epoch_next_ + batch_.size() > order_.size()) {  // a new epoch: Fisher-Yates
+      for (std::size_t i = 0; i + 1 < order_.size(); ++i) {
+        std::uniform_int_distribution<std::size_t> pick(i, order_.size() - 1);
+        std::swap(order_[i], order_[pick(rng_)]);
+      }
+      epoch_next_ = 0;
+    }
+    std::copy_n(order_.begin() + std::ptrdiff_t(epoch_next_), batch_.size(), batch_.begin());
+    epoch_next_ += batch_.size();
+    return;
+  }
   for (std::size_t i = 0; i < batch_.size(); ++i) {
     if (draw_ == Draw::kWithReplacement) {
       batch_[i] = std::uniform_int_distribution<Eigen::Index>(0, rows_ - 1)(rng_);
@@ -38,6 +52,7 @@ std::string RowSampler::state() const {
   std::ostringstream out;
   out << rng_;
   for (Eigen::Index row : order_) out << ' ' << row;
+  if (draw_ == Draw::kEpochs) out << ' ' << epoch_next_;
   return out.str();
 }
 
@@ -45,6 +60,10 @@ void RowSampler::set_state(const std::string& state) {
   std::istringstream in(state);
   in >> rng_;
   for (Eigen::Index& row : order_) in >> row;
+  if (draw_ == Draw::kEpochs) {
+    in >> epoch_next_;
+    HNN_TASKS_CHECK(epoch_next_ <= order_.size(), "the checkpoint's sampler state is corrupt");
+  }
   HNN_TASKS_CHECK(!in.fail(), "the checkpoint's sampler state is corrupt");
   in >> std::ws;
   HNN_TASKS_CHECK(in.eof(), "the checkpoint's sampler state is of another sampler");

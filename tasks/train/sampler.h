@@ -15,6 +15,8 @@ class RowSampler {
   enum class Draw {
     kWithReplacement,     // independent uniform rows (the paper's minibatch tasks)
     kWithoutReplacement,  // a fresh partial shuffle per step, as torch.randperm(n)[:batch]
+    kEpochs,  // shuffled epochs, as torch's DataLoader(shuffle=True, drop_last=True): each epoch
+              // a fresh shuffle, its batches in turn; a remainder short of a batch is left out
   };
 
   /// Batches of `batch` rows of `rows`. Drawn with replacement, a batch of 0 or of every row is
@@ -38,7 +40,8 @@ class RowSampler {
   Eigen::Index rows_;
   bool full_;
   std::mt19937_64 rng_;
-  std::vector<Eigen::Index> batch_, order_;  // order_: the shuffle (without replacement)
+  std::vector<Eigen::Index> batch_, order_;  // order_: the shuffle (without replacement, epochs)
+  std::size_t epoch_next_ = 0;               // kEpochs: the first row of order_ not yet drawn
 };
 
 }  // namespace hnn::tasks

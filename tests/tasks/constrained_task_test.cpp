@@ -44,6 +44,7 @@ TEST(ConstrainedTask, HasThePeersProtocolAsItsDefaults) {
   EXPECT_TRUE(loss.rollout);
   EXPECT_EQ(loss.horizon, 4);
   EXPECT_EQ(loss.norm, RolloutNorm::kL1);
+  EXPECT_EQ(loss.minibatches, RowSampler::Draw::kEpochs);  // their DataLoader(shuffle=True)
   // Their float32, unless --dtype names another; the other tasks keep double.
   RunOptions o = tiny("chnn", "unused");
   EXPECT_EQ(resolve(*task, o).dtype, Dtype::kFloat);

@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -15,6 +16,7 @@
 #include "tasks/field/field_model_run.h"
 #include "tasks/field/field_task.h"
 #include "tasks/train/field_objective.h"
+#include "tasks/train/sampler.h"
 #include "tests/tasks/test_configs.h"
 
 namespace hnn::tasks {
@@ -165,6 +167,36 @@ TEST(Trainer, MinibatchRunIsDeterministicPerSeed) {
   auto model = new_model<double>("hnn", 2, {16, 16}, 3);
   const TrainResult r = train_model<double>(*model, d, tiny_config(30, 50), 7, {.quiet = true});
   EXPECT_NEAR(r.curve.back().train_loss, field_mse<double>(*model, d.train_x, d.train_dxdt), 1e-15);
+}
+
+// Shuffled epochs (Finzi et al.'s DataLoader): every row once per epoch, the remainder short of a
+// batch left out, a fresh order each epoch, and a checkpointed state that draws on as before.
+TEST(Trainer, EpochSamplerDrawsEveryRowOncePerEpoch) {
+  RowSampler sampler(10, 3, RowSampler::Draw::kEpochs, 7);
+  std::vector<std::vector<Eigen::Index>> epochs;
+  std::string mid_epoch;
+  for (int epoch = 0; epoch < 3; ++epoch) {
+    std::vector<Eigen::Index> seen;
+    for (int b = 0; b < 3; ++b) {  // 3 batches of 3: one row of each epoch is left out
+      if (epoch == 1 && b == 1) mid_epoch = sampler.state();
+      sampler.next();
+      seen.insert(seen.end(), sampler.rows().begin(), sampler.rows().end());
+    }
+    std::vector<Eigen::Index> sorted = seen;
+    std::sort(sorted.begin(), sorted.end());
+    EXPECT_EQ(std::adjacent_find(sorted.begin(), sorted.end()), sorted.end()) << "epoch " << epoch;
+    epochs.push_back(seen);
+  }
+  EXPECT_NE(epochs[0], epochs[1]);
+  RowSampler resumed(10, 3, RowSampler::Draw::kEpochs, 99);
+  resumed.set_state(mid_epoch);
+  std::vector<Eigen::Index> rest;
+  for (int b = 0; b < 5; ++b) {
+    resumed.next();
+    rest.insert(rest.end(), resumed.rows().begin(), resumed.rows().end());
+  }
+  EXPECT_TRUE(std::equal(epochs[1].begin() + 3, epochs[1].end(), rest.begin()));
+  EXPECT_TRUE(std::equal(epochs[2].begin(), epochs[2].end(), rest.begin() + 6));
 }
 
 TEST(Trainer, FullBatchIgnoresTheSeed) {
