@@ -59,8 +59,8 @@ nlohmann::json RolloutLossConfig::to_json() const {
 }
 
 const std::vector<std::string>& rollout_setting_names() {
-  static const std::vector<std::string> names = {"loss", "horizon",    "integrator",
-                                                 "dt",   "norm",       "minibatches"};
+  static const std::vector<std::string> names = {"loss", "horizon", "integrator",
+                                                 "dt",   "norm",    "minibatches"};
   return names;
 }
 
@@ -99,12 +99,12 @@ RolloutLossConfig rollout_loss_config(const nlohmann::json& s, const std::string
   } catch (const nlohmann::json::exception& e) {
     throw Error(fmt::format("{}: bad rollout-loss settings {}: {}", task, s.dump(), e.what()));
   }
-  HNN_TASKS_CHECK(c.rollout || (!s.contains("horizon") && !s.contains("integrator") &&
-                                !s.contains("dt") && !s.contains("norm") &&
-                                !s.contains("minibatches")),
-                  "{}: --horizon, --integrator, --dt, --norm and --minibatches apply to the "
-                  "rollout loss only (add --loss rollout)",
-                  task);
+  HNN_TASKS_CHECK(
+      c.rollout || (!s.contains("horizon") && !s.contains("integrator") && !s.contains("dt") &&
+                    !s.contains("norm") && !s.contains("minibatches")),
+      "{}: --horizon, --integrator, --dt, --norm and --minibatches apply to the "
+      "rollout loss only (add --loss rollout)",
+      task);
   HNN_TASKS_CHECK(c.horizon >= 1, "{}: horizon must be at least 1 step, got {}", task, c.horizon);
   HNN_TASKS_CHECK(!s.contains("dt") || (c.dt > 0 && std::isfinite(c.dt)),
                   "{}: --dt must be a positive step, got {}", task, c.dt);

@@ -44,8 +44,8 @@ std::vector<std::string> rollout_norm_names();
 std::vector<std::string> minibatch_draw_names();
 
 /// How a run trains: its task settings "loss" (derivative or rollout), "horizon", "integrator",
-/// "dt", "norm" and "minibatches", the same keys on every task that learns a field from states. Parsed once,
-/// where a run's settings are resolved (tasks/run.cpp), into RunSettings::loss.
+/// "dt", "norm" and "minibatches", the same keys on every task that learns a field from states.
+/// Parsed once, where a run's settings are resolved (tasks/run.cpp), into RunSettings::loss.
 struct RolloutLossConfig {
   bool rollout = false;  ///< "loss": "rollout" (else dx/dt targets)
   int horizon = 1;       ///< sampling intervals per window

@@ -56,7 +56,8 @@ std::vector<BadOption> bad_train_options() {
        "real-pendulum)"},
       {{"train", "spring", "--settings", "{\"trials\": 20}"},
        "task 'spring' has no setting 'trials' (known: loss, horizon, integrator, dt, norm, "
-       "baseline_output, fit, sampler, rcond, solver, regularization, solver_tolerance, "
+       "minibatches, baseline_output, fit, sampler, rcond, solver, regularization, "
+       "solver_tolerance, "
        "solver_iterations, sample_dt, "
        "t_end, rollouts, rollout_t_end)"},
       {{"train", "two-body", "--settings", "{\"rollouts\": 0}"},
@@ -272,6 +273,7 @@ TEST(TrainOptionsTable, TheSweepKeysAreItsRowsInRankOrderAndTheOthersAreRefusedW
       "momenta": "p", "velocities": "v", "derivatives": "dq,dp", "time": "t",
       "trajectory": "traj", "split": "time", "test-fraction": 0.3, "hamiltonian": "q^2",
       "loss": "rollout", "horizon": 2, "integrator": "leapfrog", "dt": 0.05, "norm": "l1",
+      "minibatches": "epochs",
       "fit": "sampled+adam", "sampler": "aswim", "rcond": 1e-10, "solver": "qr",
       "regularization": 1e-9, "solver-tolerance": 1e-10, "solver-iterations": 50,
       "baseline-output": "field"})");

@@ -34,13 +34,16 @@ TEST(RolloutCli, TrainsThroughLeapfrogAndRefusesBadSettingsInOneLine) {
 
   const std::vector<BadTrain> cases = {
       {{"train", "spring", "--horizon", "3"},
-       "spring: --horizon, --integrator, --dt and --norm apply to the rollout loss only (add "
-       "--loss "
-       "rollout)\n"},
+       "spring: --horizon, --integrator, --dt, --norm and --minibatches apply to the rollout loss "
+       "only (add --loss rollout)\n"},
       {{"train", "pendulum", "--integrator", "midpoint"},
-       "pendulum: --horizon, --integrator, --dt and --norm apply to the rollout loss only"},
+       "pendulum: --horizon, --integrator, --dt, --norm and --minibatches apply to the rollout"},
       {{"train", "two-body", "--dt", "0.1"},
-       "two-body: --horizon, --integrator, --dt and --norm apply to the rollout loss only"},
+       "two-body: --horizon, --integrator, --dt, --norm and --minibatches apply to the rollout"},
+      {{"train", "spring", "--minibatches", "epochs"},
+       "spring: --horizon, --integrator, --dt, --norm and --minibatches apply to the rollout"},
+      {{"train", "spring", "--loss", "rollout", "--minibatches", "sometimes"},
+       "--minibatches: sometimes not in {independent,epochs}"},
       {{"train", "spring", "--loss", "rollout", "--horizon", "30"},
        "a horizon of 30 steps is past the end of every training stretch (the longest has 30 "
        "points, so 29 steps at most)\n"},
