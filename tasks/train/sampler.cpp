@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <numeric>
 #include <sstream>
+#include <string_view>
 
 #include "tasks/error.h"
 
@@ -48,8 +49,14 @@ void RowSampler::next() {
   }
 }
 
+namespace {
+// An epochs sampler's state starts with this word; the other two keep their older form.
+constexpr std::string_view kEpochsTag = "epochs";
+}  // namespace
+
 std::string RowSampler::state() const {
   std::ostringstream out;
+  if (draw_ == Draw::kEpochs) out << kEpochsTag << ' ';
   out << rng_;
   for (Eigen::Index row : order_) out << ' ' << row;
   if (draw_ == Draw::kEpochs) out << ' ' << epoch_next_;
@@ -57,7 +64,14 @@ std::string RowSampler::state() const {
 }
 
 void RowSampler::set_state(const std::string& state) {
-  std::istringstream in(state);
+  const bool tagged = state.starts_with(kEpochsTag);
+  HNN_TASKS_CHECK(tagged == (draw_ == Draw::kEpochs),
+                  "the checkpoint drew its minibatches {}, this run {} (--minibatches; a "
+                  "constrained task's runs from before it drew shuffled epochs): resume it with "
+                  "the hnn that wrote it, or train it again",
+                  tagged ? "as shuffled epochs" : "independently",
+                  draw_ == Draw::kEpochs ? "as shuffled epochs" : "independently");
+  std::istringstream in(tagged ? state.substr(kEpochsTag.size()) : state);
   in >> rng_;
   for (Eigen::Index& row : order_) in >> row;
   if (draw_ == Draw::kEpochs) {

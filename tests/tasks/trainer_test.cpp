@@ -197,6 +197,18 @@ TEST(Trainer, EpochSamplerDrawsEveryRowOncePerEpoch) {
   }
   EXPECT_TRUE(std::equal(epochs[1].begin() + 3, epochs[1].end(), rest.begin()));
   EXPECT_TRUE(std::equal(epochs[2].begin(), epochs[2].end(), rest.begin() + 6));
+  // A checkpoint of the other draw is refused, saying which.
+  RowSampler independent(10, 3, RowSampler::Draw::kWithReplacement, 7);
+  try {
+    resumed.set_state(independent.state());
+    ADD_FAILURE() << "an independent sampler's state was read as an epochs one";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("drew its minibatches independently, this run as "
+                                         "shuffled epochs"),
+              std::string::npos)
+        << e.what();
+  }
+  EXPECT_THROW(independent.set_state(mid_epoch), Error);
 }
 
 TEST(Trainer, FullBatchIgnoresTheSeed) {
