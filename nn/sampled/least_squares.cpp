@@ -158,10 +158,15 @@ void check_finite(const ColMat& c) {
 // dgelsd (kQr, the reference) or Tikhonov on the triangle (kRidge), at the memory of the
 // reduction.
 void solve_reduced(const LinearSystem& system, LeastSquaresSolver solver, double rcond,
-                   LeastSquaresResult& out) {
+                   ReducedProblem* reduced, LeastSquaresResult& out) {
   auto start = Clock::now();
   ColMat a, b;
-  system.reduced(a, b);
+  if (reduced != nullptr && !reduced->empty()) {
+    a.swap(reduced->r);
+    b.swap(reduced->c);
+  } else {
+    system.reduced(a, b);
+  }
   out.gram_seconds = seconds_since(start);
   out.bytes = std::size_t(a.size() + b.size()) * sizeof(double);
   check_columns(a.colwise().squaredNorm().transpose());  // the reduction keeps column norms
@@ -178,13 +183,14 @@ void solve_reduced(const LinearSystem& system, LeastSquaresSolver solver, double
 
 }  // namespace
 
-LeastSquaresResult solve_least_squares(const LinearSystem& system, const SampledFitConfig& config) {
+LeastSquaresResult solve_least_squares(const LinearSystem& system, const SampledFitConfig& config,
+                                       ReducedProblem* reduced) {
   const BlasThreads threads;
   LeastSquaresResult out;
   const Index p = system.unknowns();
   if (config.solver != LeastSquaresSolver::kLsqr &&
       config.solver != LeastSquaresSolver::kCholesky) {
-    solve_reduced(system, config.solver, config.rcond.value(), out);
+    solve_reduced(system, config.solver, config.rcond.value(), reduced, out);
   } else {
     auto start = Clock::now();
     ColMat g(p, p);

@@ -166,10 +166,30 @@ void ridge_walk(std::vector<Fold>& folds, const std::vector<double>& ladder,
   for (; i < ladder.size(); ++i) squared[i] = std::numeric_limits<double>::infinity();
 }
 
+// The whole problem's triangle from a fold's: its training triangle (a, b) and its held-out
+// points' own, merged by one QR of the stacked triangles. The fold's a and b are consumed.
+void merge_halves(Fold& fold, ReducedProblem& whole) {
+  ColMat t, d;
+  fold.held_out->reduced(t, d);
+  if (t.rows() < t.cols()) {  // fewer held-out rows than unknowns: zero rows change nothing
+    const Index rows = t.rows();
+    t.conservativeResize(t.cols(), Eigen::NoChange);
+    d.conservativeResize(t.cols(), Eigen::NoChange);
+    t.bottomRows(t.rows() - rows).setZero();
+    d.bottomRows(d.rows() - rows).setZero();
+  }
+  reduce_to_triangle(t, d);
+  qr_merge_triangle(fold.a, t, fold.b, d);
+  whole.r.swap(fold.a);
+  whole.c.swap(fold.b);
+}
+
 }  // namespace
 
 double choose_rcond(const SystemOn& system_on, const std::vector<PointSplit>& folds,
-                    LeastSquaresSolver solver, std::vector<RcondTrial>& curve) {
+                    LeastSquaresSolver solver, std::vector<RcondTrial>& curve,
+                    ReducedProblem* whole) {
+  const bool merge = whole != nullptr && folds.size() == 1;
   const BlasThreads threads;
   const std::vector<double> ladder = rcond_ladder();
   std::vector<double> squared(ladder.size(), 0.0);
@@ -181,12 +201,23 @@ double choose_rcond(const SystemOn& system_on, const std::vector<PointSplit>& fo
       prepared.emplace_back(system_on, split);
       target += prepared.back().held_out->rhs().squaredNorm();
     }
-    ridge_walk(prepared, ladder, squared, ranks);
+    ridge_walk(prepared, ladder, squared, ranks);  // leaves each fold's triangle in a, b
+    if (merge) merge_halves(prepared.front(), *whole);
   } else {  // a fold at a time: one SVD's factors held at once
     for (const PointSplit& split : folds) {
       Fold fold(system_on, split);
       target += fold.held_out->rhs().squaredNorm();
+      if (merge) {
+        reduce_to_triangle(fold.a, fold.b);
+        whole->r = fold.a;
+        whole->c = fold.b;
+      }
       svd_rungs(fold, ladder, squared, ranks);
+      if (merge) {
+        fold.a.swap(whole->r);
+        fold.b.swap(whole->c);
+        merge_halves(fold, *whole);
+      }
     }
   }
   double best = std::numeric_limits<double>::infinity(), chosen = ladder.front();

@@ -14,6 +14,7 @@
 #include <memory>
 #include <vector>
 
+#include "nn/sampled/least_squares.h"
 #include "nn/sampled/sampled_fit.h"
 #include "nn/sampled/systems.h"
 
@@ -42,7 +43,11 @@ using SystemOn = std::function<std::unique_ptr<LinearSystem>(const std::vector<E
 /// The cutoff of rcond_ladder() whose fits by `solver` (qr or ridge) on each fold's training
 /// points have the smallest relative field error over the held-out points of every fold (ties to
 /// the smaller cutoff), and every cutoff's error in `curve` (ridge: those its walk reached).
+/// With one fold and `whole`, also the whole problem's triangle: the fold's training triangle
+/// merged with its held-out points' (one dtpqrt), which saves the fit at the chosen cutoff a
+/// reduction of all the points (qr_apply's 11 s of the Henon-Heiles protocol's fit).
 double choose_rcond(const SystemOn& system_on, const std::vector<PointSplit>& folds,
-                    LeastSquaresSolver solver, std::vector<RcondTrial>& curve);
+                    LeastSquaresSolver solver, std::vector<RcondTrial>& curve,
+                    ReducedProblem* whole = nullptr);
 
 }  // namespace hnn::nn::sampled

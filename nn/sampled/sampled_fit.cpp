@@ -125,6 +125,7 @@ Fitted fit_once(const DynamicsConfig& mc, const ColMat& x, const ColMat& dxdt,
   fit.layers = sample_hidden(mc, x, sampler, target, rng, keep_last ? &fit.last_hidden : nullptr);
   report.sample_seconds += seconds_from(start);
   SampledFitConfig solve = config;
+  sampled::ReducedProblem whole;  // auto's validation leaves the whole problem reduced
   if (reads_rcond(config.solver) && !config.rcond) {
     start = Clock::now();
     const auto on = [&](const std::vector<Index>& rows) {
@@ -133,7 +134,7 @@ Fitted fit_once(const DynamicsConfig& mc, const ColMat& x, const ColMat& dxdt,
       return last_layer_system(mc, fit.layers, hidden, x(rows, Eigen::all), dxdt(rows, Eigen::all));
     };
     solve.rcond = sampled::choose_rcond(on, sampled::validation_folds(x.rows()), config.solver,
-                                        report.rcond_validation);
+                                        report.rcond_validation, &whole);
     report.validation_seconds += seconds_from(start);
   }
   report.rcond = solve.rcond.value_or(0);
@@ -148,7 +149,7 @@ Fitted fit_once(const DynamicsConfig& mc, const ColMat& x, const ColMat& dxdt,
         "lower the width or give more points",
         system->unknowns(), system->equations(), x.rows()));
   }
-  const sampled::LeastSquaresResult solved = sampled::solve_least_squares(*system, solve);
+  const sampled::LeastSquaresResult solved = sampled::solve_least_squares(*system, solve, &whole);
   report.assemble_seconds += solved.gram_seconds;
   report.gram_seconds += solved.gram_seconds;
   report.solve_seconds += solved.solve_seconds;

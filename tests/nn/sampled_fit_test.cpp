@@ -299,6 +299,26 @@ TEST(SampledFit, AutoRcondRefitsOnEveryPointAtTheChosenCutoff) {
   }
 }
 
+// With one held-out fold (10,000 points or more) the validation's two halves, merged, are the
+// whole problem's triangle: the refit reduces nothing again, and fits as an explicit --rcond of
+// the chosen value does, up to rounding.
+TEST(SampledFit, AutoRcondReusesTheFoldsTriangleForTheRefit) {
+  const Problem data = with_noise(pendulum(10000, 2), 0.01, 7);
+  for (LeastSquaresSolver solver : {LeastSquaresSolver::kQr, LeastSquaresSolver::kRidge}) {
+    for (ModelKind kind : {ModelKind::kHnn, ModelKind::kBaseline}) {
+      std::mt19937_64 init(1);
+      auto automatic = make_model<double>(model_config(kind, {40}), init);
+      auto explicit_model = make_model<double>(model_config(kind, {40}), init);
+      const SampledFitReport report =
+          fit_sampled(*automatic, data.x, data.dxdt, {.solver = solver});
+      fit_sampled(*explicit_model, data.x, data.dxdt, {.rcond = report.rcond, .solver = solver});
+      const Matrix<double> a = automatic->field(data.x), b = explicit_model->field(data.x);
+      EXPECT_LT((a - b).norm(), 1e-7 * b.norm()) << to_string(kind) << " " << int(solver);
+      EXPECT_LT((a - data.dxdt).norm(), 0.1 * data.dxdt.norm()) << to_string(kind);
+    }
+  }
+}
+
 // auto holds out points: one point leaves none to hold out.
 TEST(SampledFit, AutoRcondNeedsTwoPoints) {
   const Problem one = pendulum(1, 2);
