@@ -211,16 +211,11 @@ class Model {
       const ad::Var<T> h = ad::Var<T>::constant(parts[1 + horizon + j]);
       x = hnn::tasks::integrator_step(*dynamics_, x, h, integrator_);
       const ad::Var<T> target = ad::Var<T>::constant(parts[1 + j]);
-      const ad::Var<T> step_loss = l1_ ? mean_absolute_error(x, target) : nn::mse(x, target);
+      const ad::Var<T> step_loss =
+          l1_ ? hnn::tasks::mean_absolute_error(x, target) : nn::mse(x, target);
       total = total.defined() ? total + step_loss : step_loss;
     }
     return total * T(1.0 / double(horizon));
-  }
-
-  // RolloutObjective's: relu(d) + relu(-d), whose derivative is sign(d).
-  static ad::Var<T> mean_absolute_error(const ad::Var<T>& a, const ad::Var<T>& b) {
-    const ad::Var<T> d = ad::sub(a, b);
-    return ad::mean(ad::add(ad::relu(d), ad::relu(ad::neg(d))));
   }
 
   bool rollout_, l1_;

@@ -95,6 +95,12 @@ struct TrainOption {
 
 /// Every option, in the order of `hnn train --help`.
 std::span<const TrainOption> train_options();
+
+namespace detail {
+/// The rows of the field tasks' training methods (train_options_methods.cpp), which
+/// train_options() lists after its own.
+std::span<const TrainOption> training_method_options();
+}  // namespace detail
 /// The option named so ("model", "task"), or nullptr.
 const TrainOption* find_train_option(std::string_view name);
 

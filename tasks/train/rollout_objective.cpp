@@ -21,14 +21,16 @@ constexpr Eigen::Index kCurveWindows = 2000;
 // Relative slack of "a near-multiple of dt".
 constexpr double kMultipleSlack = 0.01;
 
-// mean |a - b| over every element, as relu(d) + relu(-d): its derivative is sign(d) (0 at 0).
+}  // namespace
+
+// relu(d) + relu(-d): its derivative is sign(d) (0 at 0).
 template <typename T>
 ad::Var<T> mean_absolute_error(const ad::Var<T>& a, const ad::Var<T>& b) {
   const ad::Var<T> d = ad::sub(a, b);
   return ad::mean(ad::add(ad::relu(d), ad::relu(ad::neg(d))));
 }
-
-}  // namespace
+template ad::Var<float> mean_absolute_error(const ad::Var<float>&, const ad::Var<float>&);
+template ad::Var<double> mean_absolute_error(const ad::Var<double>&, const ad::Var<double>&);
 
 namespace {
 constexpr nn::NameTable<RolloutNorm, 2> kRolloutNormNames{

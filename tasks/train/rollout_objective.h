@@ -35,6 +35,10 @@ RolloutWindows rollout_windows(const std::vector<Stretch>& stretches, int horizo
 /// error, or the mean absolute error (Finzi et al. 2020's trajectory_mae).
 enum class RolloutNorm { kL2, kL1 };
 
+/// mean |a - b| over every element, on the tape (the l1 norm's loss).
+template <typename T>
+ad::Var<T> mean_absolute_error(const ad::Var<T>& a, const ad::Var<T>& b);
+
 /// "l2" or "l1"; parse throws Error naming both.
 std::string_view to_string(RolloutNorm norm);
 std::vector<std::string> rollout_norm_names();
