@@ -7,6 +7,7 @@
 #include <array>
 #include <cmath>
 #include <numbers>
+#include <span>
 #include <stdexcept>
 
 #include "autodiff/ops.h"
@@ -72,9 +73,16 @@ void validate(const DynamicsConfig& config) {
     throw std::invalid_argument(
         fmt::format("model: an HNN needs an even state dimension x = (q, p), got {}", config.dim));
   }
-  if (config.model == ModelKind::kLnn && config.dim % 2 != 0) {
+  if (needs_velocities(config.model) && config.dim % 2 != 0) {
     throw std::invalid_argument(
-        fmt::format("model: an LNN needs an even state dimension x = (q, v), got {}", config.dim));
+        fmt::format("model: an {} needs an even state dimension x = (q, v), got {}",
+                    to_string(config.model), config.dim));
+  }
+  if (config.model == ModelKind::kMassHnn && config.activation != Activation::kTanh) {
+    throw std::invalid_argument(fmt::format(
+        "model: an hnn-mass is built for tanh (its mass matrix's tangent and gradient pass through "
+        "tanh layers), got activation '{}'",
+        to_string(config.activation)));
   }
   if (config.given_velocities && (config.model != ModelKind::kBaseline || config.dim % 2 != 0)) {
     throw std::invalid_argument(fmt::format(
@@ -113,12 +121,16 @@ void validate(const DynamicsConfig& config) {
 MlpConfig mlp_config(const DynamicsConfig& config) {
   validate(config);
   MlpConfig mlp;
-  // An angle is seen as (cos, sin); a constrained model's MLP sees the positions only.
-  mlp.widths.push_back(is_constrained(config.model) ? config.dim / 2 : config.dim + config.angles);
+  // An angle is seen as (cos, sin); a constrained model's MLP sees the positions only, a mass
+  // HNN's their embedding.
+  Index in = config.dim + config.angles;
+  if (is_constrained(config.model)) in = config.dim / 2;
+  if (config.model == ModelKind::kMassHnn) in = config.dim / 2 + config.angles;
+  mlp.widths.push_back(in);
   mlp.widths.insert(mlp.widths.end(), config.hidden.begin(), config.hidden.end());
   Index out = config.given_velocities ? config.dim / 2 : config.dim;
   if (learns_scalars(config.model)) out = config.field == FieldType::kBoth ? 2 : 1;
-  if (config.model == ModelKind::kLnn || is_constrained(config.model)) out = 1;
+  if (!learns_scalars(config.model) && config.model != ModelKind::kBaseline) out = 1;
   mlp.widths.push_back(out);
   mlp.activation = config.activation;
   mlp.init = config.init;
@@ -140,10 +152,7 @@ DynamicsModel<T>::DynamicsModel(DynamicsConfig config, Mlp<T> mlp)
 
 template <typename T>
 std::string DynamicsModel<T>::name() const {
-  if (config_.model == ModelKind::kBaseline) return "baseline";
-  if (config_.model == ModelKind::kLnn || is_constrained(config_.model)) {
-    return std::string(to_string(config_.model));
-  }
+  if (!learns_scalars(config_.model)) return std::string(to_string(config_.model));
   switch (config_.field) {
     case FieldType::kSolenoidal:
       return "hnn";
@@ -193,7 +202,7 @@ ad::Var<T> tape_constant(Index rows, Index cols, const Fill& fill) {
 
 // 1 / scale, one column per coordinate, `copies` times side by side (1 x copies * dim).
 template <typename T>
-ad::Var<T> inverse_scale(const std::vector<double>& scale, Index copies = 1) {
+ad::Var<T> inverse_scale(std::span<const double> scale, Index copies = 1) {
   const auto dim = Index(scale.size());
   return tape_constant<T>(1, copies * dim, [&](Matrix<T>& v) {
     for (Index i = 0; i < v.cols(); ++i) v(0, i) = T(1.0 / scale[std::size_t(i % dim)]);
@@ -212,38 +221,72 @@ ad::Var<T> concat(std::initializer_list<ad::Var<T>> blocks) {
   return out;
 }
 
-template <typename T>
-ad::Var<T> DynamicsModel<T>::mlp_input(const ad::Var<T>& x) const {
-  ad::Var<T> in = x;
-  if (!config_.input_scale.empty()) in = in * inverse_scale<T>(config_.input_scale);
-  const Index a = config_.angles;
-  if (a == 0) return in;
-  const ad::Var<T> angle = ad::slice_cols(in, 0, a);
-  return concat<T>({ad::cos(angle), ad::sin(angle), ad::slice_cols(in, a, in.cols() - a)});
-}
-
 namespace {
 
-// One output's gradient at the MLP's input (R x (dim + angles)) carried back to the state: the
-// chain rule through the embedding, d/dθ = -sin θ d/dcos + cos θ d/dsin, then 1 / scale.
+// What an MLP sees of coordinates y whose first `angles` columns are angles (scale: one per column
+// of y, or empty): y / scale, each angle as (cos, sin).
 template <typename T>
-ad::Var<T> to_state_gradient(const DynamicsConfig& config, const ad::Var<T>& x, ad::Var<T> g) {
-  const Index a = config.angles;
-  if (a > 0) {
-    const ad::Var<T> angle = ad::slice_cols(x, 0, a);
-    const ad::Var<T> d_angle =
-        ad::cos(angle) * ad::slice_cols(g, a, a) - ad::sin(angle) * ad::slice_cols(g, 0, a);
-    g = concat<T>({d_angle, ad::slice_cols(g, 2 * a, g.cols() - 2 * a)});
+ad::Var<T> embed(const ad::Var<T>& y, Index angles, std::span<const double> scale) {
+  const ad::Var<T> in = scale.empty() ? y : y * inverse_scale<T>(scale);
+  if (angles == 0) return in;
+  const ad::Var<T> angle = ad::slice_cols(in, 0, angles);
+  return concat<T>(
+      {ad::cos(angle), ad::sin(angle), ad::slice_cols(in, angles, in.cols() - angles)});
+}
+
+// A gradient g at embed(y) carried back to y: the chain rule through the embedding,
+// d/dθ = -sin θ d/dcos + cos θ d/dsin, then 1 / scale.
+template <typename T>
+ad::Var<T> embedding_gradient(const ad::Var<T>& y, Index angles, std::span<const double> scale,
+                              ad::Var<T> g) {
+  if (angles > 0) {
+    const ad::Var<T> angle = ad::slice_cols(y, 0, angles);
+    const ad::Var<T> d_angle = ad::cos(angle) * ad::slice_cols(g, angles, angles) -
+                               ad::sin(angle) * ad::slice_cols(g, 0, angles);
+    g = concat<T>({d_angle, ad::slice_cols(g, 2 * angles, g.cols() - 2 * angles)});
   }
-  if (config.input_scale.empty()) return g;
-  return g * inverse_scale<T>(config.input_scale);
+  return scale.empty() ? g : g * inverse_scale<T>(scale);
+}
+
+// The positions' share of a state's scales: its first half, or none.
+std::span<const double> position_scale(const DynamicsConfig& config) {
+  if (config.input_scale.empty()) return {};
+  return std::span<const double>(config.input_scale).first(std::size_t(config.dim / 2));
 }
 
 }  // namespace
 
 template <typename T>
+ad::Var<T> DynamicsModel<T>::mlp_input(const ad::Var<T>& x) const {
+  return embed(x, config_.angles, config_.input_scale);
+}
+
+template <typename T>
+ad::Var<T> DynamicsModel<T>::position_input(const ad::Var<T>& q) const {
+  return embed(q, config_.angles, position_scale(config_));
+}
+
+template <typename T>
+ad::Var<T> DynamicsModel<T>::position_gradient(const ad::Var<T>& q, const ad::Var<T>& g) const {
+  return embedding_gradient(q, config_.angles, position_scale(config_), g);
+}
+
+// d embed(q) = (-sin θ dθ, cos θ dθ, dq / scale for the rest).
+template <typename T>
+ad::Var<T> DynamicsModel<T>::position_tangent(const ad::Var<T>& q, const ad::Var<T>& q_dot) const {
+  const std::span<const double> scale = position_scale(config_);
+  const ad::Var<T> rate = scale.empty() ? q_dot : q_dot * inverse_scale<T>(scale);
+  const Index a = config_.angles;
+  if (a == 0) return rate;
+  const ad::Var<T> angle = ad::slice_cols(q, 0, a), angle_rate = ad::slice_cols(rate, 0, a);
+  return concat<T>({-(ad::sin(angle) * angle_rate), ad::cos(angle) * angle_rate,
+                    ad::slice_cols(rate, a, rate.cols() - a)});
+}
+
+template <typename T>
 ad::Var<T> DynamicsModel<T>::input_gradient(const ad::Var<T>& x, Index column) const {
-  return to_state_gradient(config_, x, mlp_.input_gradient(mlp_input(x), column));
+  return embedding_gradient(x, config_.angles, config_.input_scale,
+                            mlp_.input_gradient(mlp_input(x), column));
 }
 
 template <typename T>
@@ -257,7 +300,8 @@ ad::Var<T> DynamicsModel<T>::input_gradients(const ad::Var<T>& x) const {
   thread_local std::vector<ad::Var<T>> blocks;    // reused: no allocation per step
   blocks.clear();
   for (Index j = 0; j < mlp_.output_dim(); ++j)
-    blocks.push_back(to_state_gradient(config_, x, ad::slice_cols(g, j * width, width)));
+    blocks.push_back(embedding_gradient(x, config_.angles, config_.input_scale,
+                                        ad::slice_cols(g, j * width, width)));
   const ad::Var<T> all = ad::concat_cols<T>(blocks);
   blocks.clear();  // release the handles (capacity stays)
   return all;

@@ -23,6 +23,9 @@ enum class ModelKind {
   // and the constraint forces from multipliers (nn/constrained/constrained_model.h).
   kChnn,  // the constrained Hamiltonian NN: J dH projected onto the constraints
   kClnn,  // the constrained Lagrangian NN: M a = -dV - DPhi^T lambda
+  // Finzi et al.'s HNN (nn/mass_hnn.h): H = 1/2 p^T M^-1(q) p + V(q) with M^-1 and V learned,
+  // on states x = (q, v = dq/dt), p = M(q) v.
+  kMassHnn,
 };
 
 /// How an HNN turns learned scalars into a field (the reference's field_type).
@@ -40,20 +43,23 @@ inline bool learns_scalars(ModelKind kind) {
 inline bool is_constrained(ModelKind kind) {
   return kind == ModelKind::kChnn || kind == ModelKind::kClnn;
 }
-/// Whether the state's second half is velocities dq/dt (an LNN's), not canonical momenta, of the
-/// task's own coordinates. (A CHNN's and a CLNN's are velocities too, but of the Cartesian points
-/// of DynamicsConfig::constraints, which no task in generalised coordinates has.)
-inline bool needs_velocities(ModelKind kind) { return kind == ModelKind::kLnn; }
+/// Whether the state's second half is velocities dq/dt (an LNN's, a mass HNN's), not canonical
+/// momenta, of the task's own coordinates. (A CHNN's and a CLNN's are velocities too, but of the
+/// Cartesian points of DynamicsConfig::constraints, which no task in generalised coordinates has.)
+inline bool needs_velocities(ModelKind kind) {
+  return kind == ModelKind::kLnn || kind == ModelKind::kMassHnn;
+}
 
-/// The names: "hnn", "baseline", "dhnn", "lnn", "chnn", "clnn"; "solenoidal", "conservative",
-/// "both".
-inline constexpr NameTable<ModelKind, 6> kModelKindNames{{
+/// The names: "hnn", "baseline", "dhnn", "lnn", "chnn", "clnn", "hnn-mass"; "solenoidal",
+/// "conservative", "both".
+inline constexpr NameTable<ModelKind, 7> kModelKindNames{{
     {ModelKind::kHnn, "hnn"},
     {ModelKind::kBaseline, "baseline"},
     {ModelKind::kDhnn, "dhnn"},
     {ModelKind::kLnn, "lnn"},
     {ModelKind::kChnn, "chnn"},
     {ModelKind::kClnn, "clnn"},
+    {ModelKind::kMassHnn, "hnn-mass"},
 }};
 inline constexpr NameTable<FieldType, 3> kFieldTypeNames{{
     {FieldType::kSolenoidal, "solenoidal"},
@@ -101,7 +107,7 @@ struct DynamicsConfig {
 /// The MLP of a model: dim -> hidden... -> out, with out = dim for the baseline (dim / 2 with
 /// given_velocities), the number of learned scalars for an HNN (1, or 2 for kBoth: column 0 is
 /// H, column 1 is D), 1 (L) for an LNN; N d -> hidden... -> 1 (V of the positions) for a CHNN or
-/// CLNN.
+/// CLNN; dim / 2 (+ angles) -> hidden... -> 1 (V of q) for a mass HNN.
 MlpConfig mlp_config(const DynamicsConfig& config);
 /// Throws std::invalid_argument when the config cannot make a model (odd HNN dim, ...).
 void validate(const DynamicsConfig& config);
@@ -146,6 +152,12 @@ class DynamicsModel : public Module<T> {
   ad::Var<T> input_gradient(const ad::Var<T>& x, Index column) const;
   /// input_gradient of every MLP output side by side, R x (outputs * dim) (Mlp::input_gradients).
   ad::Var<T> input_gradients(const ad::Var<T>& x) const;
+  /// For MLPs of the positions q alone (the first half of a state, R x dim / 2): what the MLP
+  /// sees of them (mlp_input's embedding), a gradient there carried back to q, and the tangent
+  /// of the embedding along dq/dt = q_dot.
+  ad::Var<T> position_input(const ad::Var<T>& q) const;
+  ad::Var<T> position_gradient(const ad::Var<T>& q, const ad::Var<T>& g) const;
+  ad::Var<T> position_tangent(const ad::Var<T>& q, const ad::Var<T>& q_dot) const;
 
   DynamicsConfig config_;
   Mlp<T> mlp_;

@@ -220,7 +220,10 @@ ExportFormat parse_export_format(std::string_view name) {
 void check_exportable(const DynamicsModel<double>& model) {
   const DynamicsConfig& config = model.config();
   if (!learns_scalars(config.model) || !dynamic_cast<const Hnn<double>*>(&model)) {
-    throw std::invalid_argument("cannot export a baseline model: it has no learned H");
+    throw std::invalid_argument(fmt::format("cannot export a {} model: {}", model.name(),
+                                            config.model == ModelKind::kBaseline
+                                                ? "it has no learned H"
+                                                : "export writes an HNN's H, one MLP of (q, p)"));
   }
   if (config.field != FieldType::kSolenoidal) {
     throw std::invalid_argument(fmt::format(

@@ -8,6 +8,7 @@
 #include "autodiff/tape.h"
 #include "nn/constrained/constrained_model.h"
 #include "nn/lnn.h"
+#include "nn/mass_hnn.h"
 
 namespace hnn::nn {
 
@@ -15,8 +16,9 @@ namespace {
 
 // An Hnn is built from a kHnn or kDhnn config, a Baseline from a kBaseline one.
 const DynamicsConfig& require(const DynamicsConfig& config, ModelKind kind) {
-  if (learns_scalars(config.model) != learns_scalars(kind) || config.model == ModelKind::kLnn ||
-      is_constrained(config.model)) {
+  const bool fits = kind == ModelKind::kBaseline ? config.model == ModelKind::kBaseline
+                                                 : learns_scalars(config.model);
+  if (!fits) {
     throw std::invalid_argument(fmt::format("a {} model cannot be built from a '{}' config",
                                             to_string(kind), to_string(config.model)));
   }
@@ -149,6 +151,7 @@ Matrix<T> Baseline<T>::field(const MatrixView<T>& x) const {
 template <typename T>
 std::unique_ptr<DynamicsModel<T>> make_model(const DynamicsConfig& config, std::mt19937_64& rng) {
   if (config.model == ModelKind::kLnn) return std::make_unique<Lnn<T>>(config, rng);
+  if (config.model == ModelKind::kMassHnn) return std::make_unique<MassHnn<T>>(config, rng);
   if (is_constrained(config.model)) return std::make_unique<ConstrainedModel<T>>(config, rng);
   if (learns_scalars(config.model)) return std::make_unique<Hnn<T>>(config, rng);
   return std::make_unique<Baseline<T>>(config, rng);
@@ -156,6 +159,9 @@ std::unique_ptr<DynamicsModel<T>> make_model(const DynamicsConfig& config, std::
 
 template <typename U, typename T>
 std::unique_ptr<DynamicsModel<U>> cast_model(const DynamicsModel<T>& model) {
+  if (const auto* mass = dynamic_cast<const MassHnn<T>*>(&model)) {
+    return std::make_unique<MassHnn<U>>(mass->template cast<U>());
+  }
   Mlp<U> mlp = model.mlp().template cast<U>();
   if (model.config().model == ModelKind::kLnn) {
     return std::make_unique<Lnn<U>>(model.config(), std::move(mlp));

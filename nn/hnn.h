@@ -67,7 +67,7 @@ class Baseline : public DynamicsModel<T> {
   }
 };
 
-/// An Hnn, Lnn, ConstrainedModel (chnn, clnn) or Baseline, as config.model says, initialised
+/// An Hnn, Lnn, ConstrainedModel (chnn, clnn), MassHnn or Baseline, as config.model says, initialised
 /// from `rng`.
 template <typename T>
 std::unique_ptr<DynamicsModel<T>> make_model(const DynamicsConfig& config, std::mt19937_64& rng);

@@ -12,6 +12,7 @@
 #include "nn/init.h"
 #include "nn/linear.h"
 #include "nn/lnn.h"
+#include "nn/mass_hnn.h"
 #include "nn/loss.h"
 #include "nn/mlp.h"
 #include "nn/module.h"

@@ -65,7 +65,7 @@ std::string needs_velocities_note(nn::ModelKind model) {
     if (std::find(models.begin(), models.end(), model) != models.end()) fits.push_back(name);
   }
   return fmt::format(
-      ": an {} learns L(q, dq/dt) from coordinates and their velocities, which "
+      ": an {} learns from coordinates and their velocities, which "
       "this task's states are not (tasks that have them: {})",
       nn::to_string(model), fmt::join(fits, ", "));
 }

@@ -10,6 +10,7 @@
 #include "apps/python/arrays.h"
 #include "nn/hnn.h"
 #include "nn/lnn.h"
+#include "nn/mass_hnn.h"
 #include "nn/parameter_file.h"
 #include "physics/integrator.h"
 #include "tasks/evaluate/rollouts.h"
@@ -44,12 +45,12 @@ ModelSpec spec_of_file(const fs::path& path, long angles, double kinetic_prior) 
   } else if (name == "hnn-conservative") {
     c.field = nn::FieldType::kConservative;
   } else {
-    c.model = nn::parse_model_kind(name);  // hnn, baseline, lnn
+    c.model = nn::parse_model_kind(name);  // hnn, baseline, lnn, hnn-mass
   }
   c.activation = nn::parse_activation(info.kind.substr(colon + 1));
   std::vector<Eigen::Index> widths;
   for (const nn::ParameterFileInfo::Entry& e : info.entries) {
-    if (e.name.ends_with(".weight")) {
+    if (e.name.starts_with("mlp.") && e.name.ends_with(".weight")) {  // a mass HNN's V
       if (widths.empty()) widths.push_back(e.rows);
       widths.push_back(e.cols);
     }
@@ -57,7 +58,8 @@ ModelSpec spec_of_file(const fs::path& path, long angles, double kinetic_prior) 
   if (widths.size() < 2)
     throw InputError(fmt::format("{}: the file holds no layers of a model", path.string()));
   c.angles = angles;
-  c.dim = widths.front() - angles;  // an angle is seen as (cos, sin)
+  c.dim = widths.front() - angles;                     // an angle is seen as (cos, sin)
+  if (c.model == nn::ModelKind::kMassHnn) c.dim *= 2;  // its MLPs see the positions alone
   c.hidden.assign(widths.begin() + 1, widths.end() - 1);
   c.kinetic_prior = kinetic_prior;
   return spec;
@@ -119,6 +121,8 @@ py::array Model::hamiltonian(const py::handle& x) const {
       h = hnn->energy(states.view());
     } else if (const auto* lnn = dynamic_cast<const nn::Lnn<T>*>(&m)) {
       h = lnn->energy(states.view());  // the energy an LNN conserves, v · dL/dv - L
+    } else if (const auto* mass = dynamic_cast<const nn::MassHnn<T>*>(&m)) {
+      h = mass->energy(states.view());  // 1/2 p . v + V(q), p = M(q) v
     } else {
       throw InputError(fmt::format("hamiltonian: a {} model learns no H", m.name()));
     }

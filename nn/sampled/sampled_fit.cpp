@@ -50,6 +50,11 @@ void check_inputs(const DynamicsConfig& config, const Matrix<double>& x,
         "sampled fit: an LNN's accelerations solve a system with the Hessian d2L/dv2, which is not "
         "linear in the last layer's weights, so no least-squares fit exists; train it with Adam");
   }
+  if (config.model == ModelKind::kMassHnn) {
+    throw std::invalid_argument(
+        "sampled fit: an hnn-mass's field passes through its learned mass matrix, which is not "
+        "linear in the last layers' weights, so no least-squares fit exists; train it with Adam");
+  }
   if (is_constrained(config.model)) {
     throw std::invalid_argument(fmt::format(
         "sampled fit: a {}'s field solves for constraint forces, which are not linear in the last "

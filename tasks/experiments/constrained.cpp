@@ -6,8 +6,9 @@
 // Cartesian (x, v) with its floor and the failed rollouts counted.
 //
 // The baseline learns the Cartesian state z = (x, v). On the chains the HNN learns the angle twin
-// (theta, p) and the LNN (theta, omega) (physics/constrained/chain_angles.h); their rollouts are
-// mapped to Cartesian (x, v) before the metric, so every model is scored alike.
+// (theta, p), the LNN and the mass HNN (their HNN) (theta, omega) (physics/constrained/
+// chain_angles.h); their rollouts are mapped to Cartesian (x, v) before the metric, so every model
+// is scored alike.
 
 #include <fmt/format.h>
 
@@ -38,12 +39,12 @@ constexpr int kMaxChunkedTrajectories = 100'000;
 constexpr std::uint64_t kConstrainedFloorSeed = 0x5eed;
 
 // The state a model learns: the system's own, or the chain's angles with canonical momenta
-// (HNN) or angular velocities (LNN).
+// (HNN) or angular velocities (LNN, mass HNN).
 enum class Coordinates { kCartesian, kAngles, kAngleVelocities };
 
 Coordinates model_coordinates(nn::ModelKind model) {
   if (model == nn::ModelKind::kHnn) return Coordinates::kAngles;
-  if (model == nn::ModelKind::kLnn) return Coordinates::kAngleVelocities;
+  if (nn::needs_velocities(model)) return Coordinates::kAngleVelocities;
   return Coordinates::kCartesian;
 }
 
@@ -132,12 +133,12 @@ class ConstrainedTask : public FieldTask {
   std::vector<nn::ModelKind> models() const override {
     using nn::ModelKind;
     if (entry_.links == 0) return {ModelKind::kBaseline, ModelKind::kChnn, ModelKind::kClnn};
-    return {ModelKind::kBaseline, ModelKind::kHnn, ModelKind::kLnn, ModelKind::kChnn,
-            ModelKind::kClnn};
+    return {ModelKind::kBaseline, ModelKind::kHnn,  ModelKind::kMassHnn,
+            ModelKind::kLnn,      ModelKind::kChnn, ModelKind::kClnn};
   }
   nn::ConstraintSpec constraints() const override { return model_constraints(cartesian_.spec()); }
   std::string refusal_reason(nn::ModelKind model) const override {
-    if (model != nn::ModelKind::kHnn && model != nn::ModelKind::kLnn) return "";
+    if (model_coordinates(model) == Coordinates::kCartesian) return "";
     return fmt::format(
         ": an {} learns this system in angle coordinates, which hnn has for the chain pendulums "
         "only (physics/constrained/chain_angles.h), not for the {}",

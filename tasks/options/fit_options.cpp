@@ -10,13 +10,16 @@ namespace hnn::tasks {
 
 namespace fs = std::filesystem;
 
-// An LNN's accelerations come from inverting its Hessian in dq/dt: not linear in its last layer.
+// An LNN's accelerations invert its Hessian in dq/dt, a mass HNN's its learned mass matrix: neither
+// is linear in a last layer.
 void check_fit_model(const FitConfig& fit, nn::ModelKind model, const std::string& task) {
-  HNN_TASKS_CHECK(!fit.samples() || model != nn::ModelKind::kLnn,
-                  "{}: --fit {} does not fit an lnn: its accelerations are not linear in its last "
-                  "layer (they invert the Hessian of L in dq/dt), so no least-squares solve gives "
-                  "it (models it fits: hnn, baseline, dhnn)",
-                  task, fit.name());
+  HNN_TASKS_CHECK(
+      !fit.samples() || !nn::needs_velocities(model),
+      "{}: --fit {} does not fit an {}: its accelerations are not linear in its last "
+      "layer (they invert {}), so no least-squares solve gives it (models it fits: "
+      "hnn, baseline, dhnn)",
+      task, fit.name(), nn::to_string(model),
+      model == nn::ModelKind::kLnn ? "the Hessian of L in dq/dt" : "its learned mass matrix");
 }
 
 const char* adam_option_given(const RunOptions& o) {

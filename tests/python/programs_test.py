@@ -139,6 +139,20 @@ class Programs(unittest.TestCase):
                                       hnn.load_run(os.path.join(self.dir, "cli")).model
                                       .vector_field(x))
 
+    def test_load_reads_a_mass_hnns_two_networks(self):
+        # Finzi et al.'s HNN: V and the mass factor, both MLPs of the chain's two angles.
+        run_hnn("train", "chain-pendulum-2", "--model", "hnn-mass", "--out", "mass", "--steps",
+                "2", "--hidden", "6", "--batch", "4", "--dtype", "double", "--quiet",
+                "--settings", '{"trajectories": 4, "validation": 2, "rollouts": 2}', cwd=self.dir)
+        run_dir = os.path.join(self.dir, "mass")
+        model = hnn.load(os.path.join(run_dir, "params.bin"), angles=2)
+        self.assertEqual((model.kind, model.dim), ("hnn-mass", 4))
+        x = np.array([[0.3, -0.2, 0.1, 0.5], [1.0, 2.0, -0.4, 0.2]])
+        field = model.vector_field(x)
+        np.testing.assert_array_equal(field[:, :2], x[:, 2:])  # dq/dt = v
+        np.testing.assert_array_equal(field, hnn.load_run(run_dir).model.vector_field(x))
+        self.assertEqual(model.hamiltonian(x).shape, (2,))
+
 
 if __name__ == "__main__":
     unittest.main()

@@ -27,7 +27,7 @@ std::vector<BadOption> bad_train_options() {
       {{"train", "spring", "--batch", "751", "--hidden", "8"},
        "--batch 751 is larger than the training set (750 rows)"},
       {{"train", "spring", "--model", "transformer"},
-       "--model: transformer not in {hnn,baseline,dhnn,lnn,chnn,clnn}"},
+       "--model: transformer not in {hnn,baseline,dhnn,lnn,chnn,clnn,hnn-mass}"},
       {{"train", "pixel-pendulum", "--model", "dhnn"},
        "task 'pixel-pendulum' does not train a dhnn model (its models: hnn, baseline)"},
       {{"train", "spring", "--dtype", "half"}, "--dtype: half not in {float,double}"},

@@ -159,7 +159,7 @@ class Options(CompareCase):
         self.assertEqual(result.returncode, 0, result.stderr)
         lines = result.stdout.splitlines()
         for task in ("chain-pendulum-2", "chain-pendulum-3", "chain-pendulum-5"):
-            for model in ("baseline", "hnn", "lnn", "chnn", "clnn"):
+            for model in ("baseline", "hnn", "hnn-mass", "lnn", "chnn", "clnn"):
                 self.assertIn(f"{task} {model} rollout: 3 runs", lines)
         self.assertIn("gyroscope chnn rollout: 3 runs", lines)
         self.assertTrue(any(l.startswith("gyroscope hnn rollout: skipped: ") for l in lines))

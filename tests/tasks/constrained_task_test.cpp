@@ -7,6 +7,7 @@
 
 #include <cmath>
 
+#include "nn/mass_hnn.h"
 #include "physics/constrained/chain_angles.h"
 #include "physics/constrained/metric.h"
 #include "physics/constrained/systems.h"
@@ -106,6 +107,32 @@ TEST(ConstrainedTask, AnAngleModelIsScoredInCartesianCoordinates) {
   EXPECT_EQ(m["cartesian_error_failed"], score.failed);
 }
 
+// Finzi et al.'s HNN learns V and M^-1 from the chain's angles and angular velocities: its run
+// records those coordinates, its loss falls, and the run loads back as a mass HNN (both MLPs in
+// its parameters) whose dq/dt is the state's velocities.
+TEST(ConstrainedTask, TheirHnnLearnsItsMassMatrixFromAnglesAndVelocities) {
+  TempDir dir("runs");
+  RunOptions o = tiny("hnn-mass", dir / "m");
+  o.steps = 30;
+  const nlohmann::json m = run_training(o);
+  EXPECT_EQ(m["coordinates"], "angles (theta, omega)");
+  EXPECT_EQ(m["model"], "hnn-mass");
+  EXPECT_EQ(m["cartesian_error_failed"], 0);
+  const std::string curve = testing::read_text(dir / "m" / "loss_curve.csv");
+  const auto loss_at = [&](std::size_t line_start) {
+    const std::size_t comma = curve.find(',', line_start);
+    return std::stod(curve.substr(comma + 1));
+  };
+  const std::size_t first = curve.find('\n') + 1, last = curve.rfind('\n', curve.size() - 2) + 1;
+  EXPECT_LT(loss_at(last), 0.8 * loss_at(first)) << curve;
+  const LoadedRun loaded = load_run(dir / "m");
+  const auto* model = dynamic_cast<const nn::MassHnn<double>*>(&loaded.run->dynamics());
+  ASSERT_NE(model, nullptr);
+  const Batch x0 = loaded.run->rollout_states(2);
+  ASSERT_EQ(x0.cols(), 4);  // (theta, omega) of two links
+  EXPECT_EQ(model->field(x0).leftCols(2), x0.rightCols(2));
+}
+
 // The CHNN and CLNN get the task's own points, masses and constraints (links and anchors on the
 // chain, pins on the gyroscope) and learn only V: their rollouts stay on the constraint manifold
 // to the rollout tolerance, whatever V they have learned.
@@ -142,7 +169,7 @@ TEST(ConstrainedTask, TheConstrainedModelsTrainOnTheSystemsOwnConstraints) {
 
 TEST(ConstrainedTask, RefusesAngleModelsWhereHnnHasNoAngles) {
   TempDir dir("runs");
-  for (const char* model : {"hnn", "lnn"}) {
+  for (const char* model : {"hnn", "hnn-mass", "lnn"}) {
     try {
       run_training(tiny(model, dir / model, "gyroscope"));
       FAIL() << model << " accepted";

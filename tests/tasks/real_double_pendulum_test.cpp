@@ -121,6 +121,18 @@ TEST(LnnOnATaskWithoutVelocities, GetsOneLineSayingWhyAndWhere) {
     }
     EXPECT_FALSE(std::filesystem::exists(dir / task));
   }
+  // Finzi et al.'s HNN learns its mass matrix from velocities too: the chains' angle twins.
+  try {
+    run_training(testing::small_run("spring", "hnn-mass", dir / "mass", 5));
+    FAIL() << "spring accepted an hnn-mass";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find(
+                  "an hnn-mass learns from coordinates and their velocities, which this task's "
+                  "states are not (tasks that have them: chain-pendulum-2, chain-pendulum-3, "
+                  "chain-pendulum-4, chain-pendulum-5)"),
+              std::string::npos)
+        << e.what();
+  }
 }
 
 }  // namespace

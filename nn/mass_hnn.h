@@ -1,0 +1,68 @@
+#pragma once
+// The HNN of Finzi, Wang & Wilson 2020 (their biases/models/hnn.py), the "HNN" of their tables:
+// a Hamiltonian with the kinetic energy's structure built in,
+//   H(q, p) = 1/2 p^T M^-1(q) p + V(q),   M^-1 = L L^T + eps I,
+// where V and the lower-triangular factor L (a softplus on its diagonal, so M^-1 is positive
+// definite) are MLPs of the positions. Like theirs it takes states as observed, x = (q, v =
+// dq/dt), with p = M(q) v. Its field in those coordinates:
+//   dq/dt = v,   dp/dt = -dH/dq (at fixed p),   dv/dt = M^-1 dp/dt + (dL L^T + L dL^T) p,
+// where dL is the factor's tangent along the motion: one forward-mode pass of its MLP beside
+// the reverse pass that dH/dq takes. Every piece is an engine op, so training differentiates
+// through the field to any order.
+
+#include <random>
+
+#include "nn/dynamics.h"
+
+namespace hnn::nn {
+
+/// The diagonal eps of M^-1 = L L^T + eps I: theirs, which keeps M^-1 invertible however small
+/// the learned factor.
+inline constexpr double kMassHnnEpsilon = 1e-4;
+
+/// config.model kMassHnn, activation tanh. Parameters: "mlp.layers.<i>.weight|bias" of V's MLP,
+/// "mass.layers.<i>.weight|bias" of L's.
+template <typename T>
+class MassHnn : public DynamicsModel<T> {
+ public:
+  /// Both MLPs initialised from `rng`, V's first; L's last bias starts at zero (as theirs).
+  MassHnn(DynamicsConfig config, std::mt19937_64& rng);
+  /// A model with the given MLPs: `potential` must match mlp_config(config), `mass`
+  /// factor_mlp_config(config).
+  MassHnn(DynamicsConfig config, Mlp<T> potential, Mlp<T> mass);
+  MassHnn(MassHnn&&) noexcept = default;
+  MassHnn& operator=(MassHnn&&) noexcept = default;
+
+  /// The learned energy H = 1/2 p . v + V(q), R x 1: what the learned motion conserves.
+  Matrix<T> energy(const MatrixView<T>& x) const;
+  /// The learned M^-1(q) of states x (R x dim), each row an n x n block row-major.
+  Matrix<T> inverse_mass(const MatrixView<T>& x) const;
+
+  /// (v, dv/dt), on the tape to any order. Throws ad::Error naming the row where a learned
+  /// M^-1 is not finite or too ill-conditioned to solve for p.
+  ad::Var<T> time_derivative(const ad::Var<T>& x) const override;
+  Matrix<T> field(const MatrixView<T>& x) const override;
+
+  const Mlp<T>& factor_mlp() const { return factor_; }
+  void visit_parameters(const ParameterVisitor<T>& visit) override;
+
+  template <typename U>
+  MassHnn<U> cast() const {
+    return MassHnn<U>(this->config_, this->mlp_.template cast<U>(), factor_.template cast<U>());
+  }
+
+ private:
+  struct Factor;                               // L and M^-1 of one batch
+  Factor factor(const ad::Var<T>& raw) const;  // from the factor MLP's output
+  void form_constants();
+
+  Mlp<T> factor_;
+  Matrix<T> strict_lower_, diagonal_;  // 1 x n^2 masks of L's entries
+  Matrix<T> gram_;                     // n^4 x n^2: batched_outer(L, L) gram_ = L L^T
+  Matrix<T> epsilon_;                  // 1 x n^2: eps I
+};
+
+/// The MLP of L: as mlp_config(config)'s, with n^2 outputs (L row-major) and a last bias.
+MlpConfig factor_mlp_config(const DynamicsConfig& config);
+
+}  // namespace hnn::nn
