@@ -133,7 +133,7 @@ class DynamicsModel : public Module<T> {
   /// name() + ":" + activation, e.g. "hnn:tanh": what checkpoints record and check.
   std::string kind() const override;
   /// "hnn 2-200-200-1 tanh orthogonal nobias", for logs.
-  std::string describe() const;
+  virtual std::string describe() const;
   /// Parameters: "mlp.layers.<i>.weight|bias".
   void visit_parameters(const ParameterVisitor<T>& visit) override;
 

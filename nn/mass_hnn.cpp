@@ -1,6 +1,7 @@
 #include "nn/mass_hnn.h"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <stdexcept>
 #include <vector>
@@ -189,6 +190,15 @@ Matrix<T> MassHnn<T>::inverse_mass(const MatrixView<T>& x) const {
   const Index n = x.cols() / 2;
   const ad::Var<T> state = ad::Var<T>::constant(x);
   return factor(factor_.forward(this->position_input(ad::slice_cols(state, 0, n)))).minv.value();
+}
+
+template <typename T>
+std::string MassHnn<T>::describe() const {
+  const auto widths = [](const Mlp<T>& mlp) {
+    return fmt::format("{}", fmt::join(mlp.config().widths, "-"));
+  };
+  return fmt::format("{} V {}, L {} {} {}", this->name(), widths(this->mlp_), widths(factor_),
+                     to_string(this->config_.activation), to_string(this->config_.init));
 }
 
 template <typename T>

@@ -43,6 +43,8 @@ class MassHnn : public DynamicsModel<T> {
   ad::Var<T> time_derivative(const ad::Var<T>& x) const override;
   Matrix<T> field(const MatrixView<T>& x) const override;
 
+  /// "hnn-mass V 2-256-256-1, L 2-256-256-4 tanh orthogonal", for logs.
+  std::string describe() const override;
   const Mlp<T>& factor_mlp() const { return factor_; }
   void visit_parameters(const ParameterVisitor<T>& visit) override;
 

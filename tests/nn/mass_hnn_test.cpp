@@ -142,6 +142,7 @@ TEST(MassHnn, HasBothNetworksAsParametersAndCastsToFloat) {
   EXPECT_EQ(model.factor_mlp().layers().back().bias().value(), MatrixD::Zero(1, 4))
       << "the factor's last bias starts at zero, as theirs";
   EXPECT_EQ(model.kind(), "hnn-mass:tanh");
+  EXPECT_EQ(model.describe(), "hnn-mass V 4-12-10-1, L 4-12-10-4 tanh orthogonal");
   const auto single = nn::cast_model<float>(model);
   const MatrixD x = random_qv(6, 4, 81);
   const MatrixD f = single->field(x.cast<float>()).cast<double>();
