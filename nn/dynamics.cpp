@@ -180,6 +180,14 @@ void DynamicsModel<T>::visit_parameters(const ParameterVisitor<T>& visit) {
 }
 
 template <typename T>
+Matrix<T> DynamicsModel<T>::field(const MatrixView<T>& x) const {
+  check_input("field", x.rows(), x.cols());
+  ad::TapeScope scope;
+  ad::NoGradGuard values_only;
+  return time_derivative(ad::Var<T>::constant(x)).value();
+}
+
+template <typename T>
 void DynamicsModel<T>::check_input(const char* what, Index rows, Index cols) const {
   if (cols != config_.dim || rows < 1) {
     throw ad::Error(fmt::format("{}.{}: input is {} but the model takes R x {}", name(), what,

@@ -122,8 +122,9 @@ class DynamicsModel : public Module<T> {
   virtual ad::Var<T> time_derivative(const ad::Var<T>& x) const = 0;
   /// f(x) as plain values, for rollouts and evaluation: records only what it needs, inside its
   /// own TapeScope, whatever the grad mode. `x` is a view: a Matrix<T>, or a buffer laid out
-  /// like one (apps/python/arrays.h passes a NumPy array's without copying it).
-  virtual Matrix<T> field(const MatrixView<T>& x) const = 0;
+  /// like one (apps/python/arrays.h passes a NumPy array's without copying it). By default
+  /// time_derivative's values on a constant x under a NoGradGuard.
+  virtual Matrix<T> field(const MatrixView<T>& x) const;
 
   const DynamicsConfig& config() const { return config_; }
   Index dim() const { return config_.dim; }

@@ -138,14 +138,6 @@ ad::Var<T> Baseline<T>::time_derivative(const ad::Var<T>& x) const {
   return ad::concat_cols<T>({ad::slice_cols(x, n, n), out});
 }
 
-template <typename T>
-Matrix<T> Baseline<T>::field(const MatrixView<T>& x) const {
-  this->check_input("field", x.rows(), x.cols());
-  ad::TapeScope scope;
-  ad::NoGradGuard values_only;
-  return time_derivative(ad::Var<T>::constant(x)).value();
-}
-
 // ---- factory ------------------------------------------------------------------------------
 
 template <typename T>

@@ -59,7 +59,6 @@ class Baseline : public DynamicsModel<T> {
   Baseline& operator=(Baseline&&) noexcept = default;
 
   ad::Var<T> time_derivative(const ad::Var<T>& x) const override;
-  Matrix<T> field(const MatrixView<T>& x) const override;
 
   template <typename U>
   Baseline<U> cast() const {
@@ -67,8 +66,8 @@ class Baseline : public DynamicsModel<T> {
   }
 };
 
-/// An Hnn, Lnn, ConstrainedModel (chnn, clnn), MassHnn or Baseline, as config.model says, initialised
-/// from `rng`.
+/// An Hnn, Lnn, ConstrainedModel (chnn, clnn), MassHnn or Baseline, as config.model says,
+/// initialised from `rng`.
 template <typename T>
 std::unique_ptr<DynamicsModel<T>> make_model(const DynamicsConfig& config, std::mt19937_64& rng);
 

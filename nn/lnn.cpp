@@ -111,14 +111,6 @@ ad::Var<T> Lnn<T>::time_derivative(const ad::Var<T>& x) const {
   return ad::concat_cols<T>({v, a});
 }
 
-template <typename T>
-Matrix<T> Lnn<T>::field(const MatrixView<T>& x) const {
-  this->check_input("field", x.rows(), x.cols());
-  ad::TapeScope scope;
-  ad::NoGradGuard values_only;
-  return time_derivative(ad::Var<T>::constant(x)).value();
-}
-
 template class Lnn<float>;
 template class Lnn<double>;
 

@@ -30,7 +30,6 @@ class Lnn : public DynamicsModel<T> {
   /// (v, dv/dt). Throws ad::Error naming the row when a block d²L/dv² is singular or
   /// ill-conditioned (the learned L has no well-defined motion there).
   ad::Var<T> time_derivative(const ad::Var<T>& x) const override;
-  Matrix<T> field(const MatrixView<T>& x) const override;
 
   template <typename U>
   Lnn<U> cast() const {

@@ -162,14 +162,6 @@ ad::Var<T> MassHnn<T>::time_derivative(const ad::Var<T>& x) const {
 }
 
 template <typename T>
-Matrix<T> MassHnn<T>::field(const MatrixView<T>& x) const {
-  this->check_input("field", x.rows(), x.cols());
-  ad::TapeScope scope;
-  ad::NoGradGuard values_only;
-  return time_derivative(ad::Var<T>::constant(x)).value();
-}
-
-template <typename T>
 Matrix<T> MassHnn<T>::energy(const MatrixView<T>& x) const {
   this->check_input("energy", x.rows(), x.cols());
   ad::TapeScope scope;

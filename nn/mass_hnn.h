@@ -41,7 +41,6 @@ class MassHnn : public DynamicsModel<T> {
   /// (v, dv/dt), on the tape to any order. Throws ad::Error naming the row where a learned
   /// M^-1 is not finite or too ill-conditioned to solve for p.
   ad::Var<T> time_derivative(const ad::Var<T>& x) const override;
-  Matrix<T> field(const MatrixView<T>& x) const override;
 
   /// "hnn-mass V 2-256-256-1, L 2-256-256-4 tanh orthogonal", for logs.
   std::string describe() const override;

@@ -58,14 +58,6 @@ ad::Var<T> ConstrainedModel<T>::time_derivative(const ad::Var<T>& x) const {
   return mechanics_.lagrangian_field(x, dv);
 }
 
-template <typename T>
-Matrix<T> ConstrainedModel<T>::field(const MatrixView<T>& x) const {
-  this->check_input("field", x.rows(), x.cols());
-  ad::TapeScope scope;
-  ad::NoGradGuard values_only;
-  return time_derivative(ad::Var<T>::constant(x)).value();
-}
-
 template class ConstrainedModel<float>;
 template class ConstrainedModel<double>;
 

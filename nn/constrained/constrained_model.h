@@ -34,7 +34,6 @@ class ConstrainedModel : public DynamicsModel<T> {
   /// through dV/dx, the Gram blocks and the solves). Throws ad::Error naming the row where the
   /// constraints are degenerate (a singular Gram block G M^-1 G^T).
   ad::Var<T> time_derivative(const ad::Var<T>& x) const override;
-  Matrix<T> field(const MatrixView<T>& x) const override;
 
   const ConstrainedMechanics<T>& mechanics() const { return mechanics_; }
 

@@ -65,17 +65,11 @@ TEST(ConstrainedTraining, LossGradientsMatchFiniteDifferencesToSecondOrder) {
     const MatrixD z = nn::testing::chain_states(spec, 3, 22) +
                       0.05 * nn::random_uniform<double>(3, 8, rng, -1, 1);
     const MatrixD target = nn::random_uniform<double>(3, 8, rng, -1, 1);
-    const auto loss = [&](const std::vector<Var<double>>& in) {
-      const_cast<nn::ConstrainedModel<double>&>(model).bind_parameters(
-          std::vector<Var<double>>(in.begin() + 1, in.end()));
-      return nn::mse(model.time_derivative(in[0]), Var<double>::constant(target));
-    };
-    std::vector<MatrixD> inputs{z};
-    for (const Var<double>& p : model.parameters()) inputs.push_back(p.value());
-    const ad::CheckResult first = ad::gradcheck(loss, inputs);
-    EXPECT_TRUE(first.ok) << nn::to_string(kind) << ": " << first.worst << "\n" << first.log;
-    const ad::CheckResult second = ad::gradgradcheck(loss, inputs);
-    EXPECT_TRUE(second.ok) << nn::to_string(kind) << ": " << second.worst << "\n" << second.log;
+    const auto checks = nn::testing::check_training_gradients(model, z, target);
+    EXPECT_TRUE(checks.first.ok) << nn::to_string(kind) << ": " << checks.first.worst << "\n"
+                                 << checks.first.log;
+    EXPECT_TRUE(checks.second.ok) << nn::to_string(kind) << ": " << checks.second.worst << "\n"
+                                  << checks.second.log;
   }
 }
 

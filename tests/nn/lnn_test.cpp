@@ -61,18 +61,10 @@ void expect_training_gradients_match(Eigen::Index angles) {
     config.angles = angles;
     return nn::Lnn<double>(config, rng);
   }();
-  const MatrixD x = random_states(3, 2, 22), target = random_states(3, 2, 23);
-  const auto loss = [&](const std::vector<Var<double>>& in) {
-    const_cast<nn::Lnn<double>&>(lnn).bind_parameters(
-        std::vector<Var<double>>(in.begin() + 1, in.end()));
-    return nn::mse(lnn.time_derivative(in[0]), Var<double>::constant(target));
-  };
-  std::vector<MatrixD> inputs{x};
-  for (const Var<double>& p : lnn.parameters()) inputs.push_back(p.value());
-  const ad::CheckResult first = ad::gradcheck(loss, inputs);
-  EXPECT_TRUE(first.ok) << first.worst << "\n" << first.log;
-  const ad::CheckResult second = ad::gradgradcheck(loss, inputs);
-  EXPECT_TRUE(second.ok) << second.worst << "\n" << second.log;
+  const auto checks =
+      nn::testing::check_training_gradients(lnn, random_states(3, 2, 22), random_states(3, 2, 23));
+  EXPECT_TRUE(checks.first.ok) << checks.first.worst << "\n" << checks.first.log;
+  EXPECT_TRUE(checks.second.ok) << checks.second.worst << "\n" << checks.second.log;
 }
 
 }  // namespace

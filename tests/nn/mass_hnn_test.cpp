@@ -119,18 +119,10 @@ TEST(MassHnn, LearnedInverseMassIsSymmetricPositiveDefinite) {
 
 TEST(MassHnn, TrainingGradientsMatchFiniteDifferencesToSecondOrder) {
   const nn::MassHnn<double> model = small_mass_hnn(4, 2, 70, {5, 4});
-  const MatrixD x = random_qv(3, 4, 71), target = random_qv(3, 4, 72);
-  const auto loss = [&](const std::vector<Var<double>>& in) {
-    const_cast<nn::MassHnn<double>&>(model).bind_parameters(
-        std::vector<Var<double>>(in.begin() + 1, in.end()));
-    return nn::mse(model.time_derivative(in[0]), Var<double>::constant(target));
-  };
-  std::vector<MatrixD> inputs{x};
-  for (const Var<double>& p : model.parameters()) inputs.push_back(p.value());
-  const ad::CheckResult first = ad::gradcheck(loss, inputs);
-  EXPECT_TRUE(first.ok) << first.worst << "\n" << first.log;
-  const ad::CheckResult second = ad::gradgradcheck(loss, inputs);
-  EXPECT_TRUE(second.ok) << second.worst << "\n" << second.log;
+  const auto checks =
+      nn::testing::check_training_gradients(model, random_qv(3, 4, 71), random_qv(3, 4, 72));
+  EXPECT_TRUE(checks.first.ok) << checks.first.worst << "\n" << checks.first.log;
+  EXPECT_TRUE(checks.second.ok) << checks.second.worst << "\n" << checks.second.log;
 }
 
 TEST(MassHnn, HasBothNetworksAsParametersAndCastsToFloat) {

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "autodiff/autodiff.h"
+#include "autodiff/gradcheck.h"
 #include "nn/nn.h"
 
 namespace hnn::nn::testing {
@@ -69,6 +70,24 @@ inline DynamicsConfig small_config(ModelKind kind, Index dim, std::vector<Index>
   config.field = field;
   config.activation = activation;
   return config;
+}
+
+/// The training loss mse(model.time_derivative(x), target) differentiated in x and in every
+/// parameter, against central differences: first (gradcheck) and second order (gradgradcheck).
+struct TrainingGradientChecks {
+  ad::CheckResult first, second;
+};
+inline TrainingGradientChecks check_training_gradients(const DynamicsModel<double>& model,
+                                                       const Matrix<double>& x,
+                                                       const Matrix<double>& target) {
+  auto& bound = const_cast<DynamicsModel<double>&>(model);  // rebound to the checks' leaves
+  const auto loss = [&](const std::vector<ad::Var<double>>& in) {
+    bound.bind_parameters(std::vector<ad::Var<double>>(in.begin() + 1, in.end()));
+    return mse(model.time_derivative(in[0]), ad::Var<double>::constant(target));
+  };
+  std::vector<Matrix<double>> inputs{x};
+  for (const ad::Var<double>& p : model.parameters()) inputs.push_back(p.value());
+  return {ad::gradcheck(loss, inputs), ad::gradgradcheck(loss, inputs)};
 }
 
 }  // namespace hnn::nn::testing
