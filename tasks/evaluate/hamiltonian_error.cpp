@@ -16,8 +16,9 @@ double hamiltonian_rel_l2(const Eigen::VectorXd& truth, const Eigen::VectorXd& l
 nlohmann::json hamiltonian_error_metrics(const physics::System& truth, const LearnedField& model,
                                          const Batch& x) {
   if (!model.hamiltonian) {
-    return {{"hamiltonian_rel_l2", nullptr},
-            {"hamiltonian_rel_l2_note", "the model learns no H (only an hnn or a dhnn does)"}};
+    return {
+        {"hamiltonian_rel_l2", nullptr},
+        {"hamiltonian_rel_l2_note", "the model learns no H (an hnn, dhnn, lnn or hnn-mass does)"}};
   }
   return {{"hamiltonian_rel_l2",
            number(hamiltonian_rel_l2(truth.hamiltonian_batch(x), model.hamiltonian(x)))},

@@ -11,6 +11,7 @@
 
 #include "nn/hnn.h"
 #include "nn/lnn.h"
+#include "nn/mass_hnn.h"
 #include "physics/integrator.h"
 #include "physics/types.h"
 #include "tasks/error.h"
@@ -102,10 +103,14 @@ LearnedField learned_field(const nn::DynamicsModel<double>& model) {
     learned.hamiltonian = [hnn](const Batch& x) -> Eigen::VectorXd {
       return hnn->energy(x).col(0);
     };
-  // An LNN's conserved quantity: its learned energy v · dL/dv - L.
+  // An LNN's conserved quantity: its learned energy v · dL/dv - L; a mass HNN's, its H in (q, v).
   if (const auto* lnn = dynamic_cast<const nn::Lnn<double>*>(&model))
     learned.hamiltonian = [lnn](const Batch& x) -> Eigen::VectorXd {
       return lnn->energy(x).col(0);
+    };
+  if (const auto* mass = dynamic_cast<const nn::MassHnn<double>*>(&model))
+    learned.hamiltonian = [mass](const Batch& x) -> Eigen::VectorXd {
+      return mass->energy(x).col(0);
     };
   return learned;
 }

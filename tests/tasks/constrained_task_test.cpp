@@ -117,6 +117,8 @@ TEST(ConstrainedTask, TheirHnnLearnsItsMassMatrixFromAnglesAndVelocities) {
   const nlohmann::json m = run_training(o);
   EXPECT_EQ(m["coordinates"], "angles (theta, omega)");
   EXPECT_EQ(m["model"], "hnn-mass");
+  EXPECT_TRUE(m["hamiltonian_rel_l2"].is_number())
+      << "its H against the truth's, up to H's constant";
   EXPECT_EQ(m["cartesian_error_failed"], 0);
   const std::string curve = testing::read_text(dir / "m" / "loss_curve.csv");
   const auto loss_at = [&](std::size_t line_start) {
