@@ -6,6 +6,7 @@
 #include <optional>
 #include <stdexcept>
 
+#include "autodiff/check.h"
 #include "autodiff/grad.h"
 #include "autodiff/tape.h"
 #include "tasks/error.h"
@@ -86,13 +87,30 @@ class TrainClock {
   std::chrono::duration<double> paused_{0};
 };
 
+// f(), or TrainingDiverged at `step` when the learned field cannot be evaluated on its rows: its
+// motion left the finite numbers within an integration (a solve met a non-finite state), or a
+// learned matrix turned singular. The run stops there as on a loss of inf, keeping the last good
+// checkpoint (`where` says which).
+template <typename F>
+auto unless_the_field_fails(long step, const char* on, const std::string& where, const F& f) {
+  try {
+    return f();
+  } catch (const ad::Error& e) {
+    throw TrainingDiverged(
+        fmt::format("training stopped at step {}: the learned field failed on {}: {}{}", step, on,
+                    e.what(), where),
+        step);
+  }
+}
+
 // One step: the batch's loss, its gradients and the optimiser's update. Returns the loss.
 template <typename T>
 double train_step(long step, Objective<T>& objective, nn::Adam<T>& adam,
                   std::vector<ad::Var<T>>& grads, const std::string& where) {
   ad::TapeScope scope;  // everything this step records is recycled at the closing brace
   objective.sampler().next();
-  const ad::Var<T> loss = objective.batch_loss();
+  const ad::Var<T> loss =
+      unless_the_field_fails(step, "the batch", where, [&] { return objective.batch_loss(); });
   const double value = double(loss.item());
   if (!std::isfinite(value)) {
     throw TrainingDiverged(
@@ -142,7 +160,9 @@ class Loop {
   void record(long step, double loss) {
     if (step % interval_ != 0 && step != o_.steps) return;
     clock_.pause_for([&] {
-      result_.curve.push_back(objective_.curve_point(step, loss));
+      result_.curve.push_back(
+          unless_the_field_fails(step, "the loss curve's splits", checkpoints_.last_good(),
+                                 [&] { return objective_.curve_point(step, loss); }));
       if (o_.on_record) o_.on_record(step);
     });
   }
