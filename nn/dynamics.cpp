@@ -188,6 +188,11 @@ Matrix<T> DynamicsModel<T>::field(const MatrixView<T>& x) const {
 }
 
 template <typename T>
+Matrix<T> DynamicsModel<T>::learned_energy(const MatrixView<T>&) const {
+  throw std::logic_error(fmt::format("a {} model learns no conserved energy", name()));
+}
+
+template <typename T>
 void DynamicsModel<T>::check_input(const char* what, Index rows, Index cols) const {
   if (cols != config_.dim || rows < 1) {
     throw ad::Error(fmt::format("{}.{}: input is {} but the model takes R x {}", name(), what,

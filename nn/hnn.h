@@ -33,6 +33,11 @@ class Hnn : public DynamicsModel<T> {
   /// The learned Hamiltonian H(x), R x 1 (the MLP's column 0); throws for kConservative.
   ad::Var<T> energy(const ad::Var<T>& x) const;
   Matrix<T> energy(const MatrixView<T>& x) const;
+  /// H, for every field type but kConservative (which learns D alone).
+  bool has_learned_energy() const override {
+    return this->config_.field != FieldType::kConservative;
+  }
+  Matrix<T> learned_energy(const MatrixView<T>& x) const override { return energy(x); }
   /// The learned dissipation potential D(x), R x 1; throws for kSolenoidal.
   ad::Var<T> dissipation(const ad::Var<T>& x) const;
 

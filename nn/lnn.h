@@ -26,6 +26,8 @@ class Lnn : public DynamicsModel<T> {
   ad::Var<T> lagrangian(const ad::Var<T>& x) const;
   /// The learned energy E = v · dL/dv - L, R x 1: what the learned motion conserves.
   Matrix<T> energy(const MatrixView<T>& x) const;
+  bool has_learned_energy() const override { return true; }
+  Matrix<T> learned_energy(const MatrixView<T>& x) const override { return energy(x); }
 
   /// (v, dv/dt). Throws ad::Error naming the row when a block d²L/dv² is singular or
   /// ill-conditioned (the learned L has no well-defined motion there).

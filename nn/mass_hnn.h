@@ -35,6 +35,8 @@ class MassHnn : public DynamicsModel<T> {
 
   /// The learned energy H = 1/2 p . v + V(q), R x 1: what the learned motion conserves.
   Matrix<T> energy(const MatrixView<T>& x) const;
+  bool has_learned_energy() const override { return true; }
+  Matrix<T> learned_energy(const MatrixView<T>& x) const override { return energy(x); }
   /// The learned M^-1(q) of states x (R x dim), each row an n x n block row-major.
   Matrix<T> inverse_mass(const MatrixView<T>& x) const;
 

@@ -10,7 +10,6 @@
 #include "apps/python/arrays.h"
 #include "nn/hnn.h"
 #include "nn/lnn.h"
-#include "nn/mass_hnn.h"
 #include "nn/parameter_file.h"
 #include "physics/integrator.h"
 #include "tasks/evaluate/rollouts.h"
@@ -115,17 +114,9 @@ py::array Model::vector_field(const py::handle& x) const {
 py::array Model::hamiltonian(const py::handle& x) const {
   return visit([&]<typename T>(const nn::DynamicsModel<T>& m) {
     const StatesIn<T> states(x, "x", m.dim());
-    Matrix<T> h;
-    if (const auto* hnn = dynamic_cast<const nn::Hnn<T>*>(&m);
-        hnn != nullptr && m.config().field != nn::FieldType::kConservative) {
-      h = hnn->energy(states.view());
-    } else if (const auto* lnn = dynamic_cast<const nn::Lnn<T>*>(&m)) {
-      h = lnn->energy(states.view());  // the energy an LNN conserves, v · dL/dv - L
-    } else if (const auto* mass = dynamic_cast<const nn::MassHnn<T>*>(&m)) {
-      h = mass->energy(states.view());  // 1/2 p . v + V(q), p = M(q) v
-    } else {
+    if (!m.has_learned_energy())
       throw InputError(fmt::format("hamiltonian: a {} model learns no H", m.name()));
-    }
+    const Matrix<T> h = m.learned_energy(states.view());  // an LNN's: v . dL/dv - L
     return to_array(h, {h.rows()});
   });
 }

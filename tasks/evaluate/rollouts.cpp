@@ -9,9 +9,7 @@
 #include <random>
 #include <stdexcept>
 
-#include "nn/hnn.h"
-#include "nn/lnn.h"
-#include "nn/mass_hnn.h"
+#include "nn/dynamics.h"
 #include "physics/integrator.h"
 #include "physics/types.h"
 #include "tasks/error.h"
@@ -98,19 +96,10 @@ void add_learned(Rollouts& r, const LearnedField& learned, const Eigen::RowVecto
 LearnedField learned_field(const nn::DynamicsModel<double>& model) {
   LearnedField learned{
       .field = [&model](double, const Batch& x, Batch& dxdt) { dxdt = model.field(x); }};
-  const auto* hnn = dynamic_cast<const nn::Hnn<double>*>(&model);
-  if (hnn != nullptr && model.config().field != nn::FieldType::kConservative)
-    learned.hamiltonian = [hnn](const Batch& x) -> Eigen::VectorXd {
-      return hnn->energy(x).col(0);
-    };
-  // An LNN's conserved quantity: its learned energy v · dL/dv - L; a mass HNN's, its H in (q, v).
-  if (const auto* lnn = dynamic_cast<const nn::Lnn<double>*>(&model))
-    learned.hamiltonian = [lnn](const Batch& x) -> Eigen::VectorXd {
-      return lnn->energy(x).col(0);
-    };
-  if (const auto* mass = dynamic_cast<const nn::MassHnn<double>*>(&model))
-    learned.hamiltonian = [mass](const Batch& x) -> Eigen::VectorXd {
-      return mass->energy(x).col(0);
+  // What the learned motion conserves: an HNN's H, an LNN's energy, a mass HNN's H.
+  if (model.has_learned_energy())
+    learned.hamiltonian = [&model](const Batch& x) -> Eigen::VectorXd {
+      return model.learned_energy(x).col(0);
     };
   return learned;
 }
