@@ -185,6 +185,12 @@ RowBlock row_block(Eigen::Index rows, int parts, int i) {
   return {rows * i / parts, rows * (i + 1) / parts};
 }
 
+RowBlock element_block(Eigen::Index n, int parts, int i) {
+  constexpr Eigen::Index kLanes = 16;  // an AVX-512 packet of floats; whole packets of any ISA
+  const RowBlock lanes = row_block((n + kLanes - 1) / kLanes, parts, i);
+  return {std::min(n, lanes.begin * kLanes), std::min(n, lanes.end * kLanes)};
+}
+
 int parts_for(Eigen::Index rows, Eigen::Index min_rows) {
   const Eigen::Index by_size =
       std::max<Eigen::Index>(1, rows / std::max<Eigen::Index>(min_rows, 1));

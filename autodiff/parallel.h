@@ -42,6 +42,13 @@ struct RowBlock {
   Eigen::Index size() const { return end - begin; }
 };
 RowBlock row_block(Eigen::Index rows, int parts, int i);
+/// Block i of `parts` nearly equal blocks of a flat array of n elements, each starting at a
+/// multiple of 16 elements: Eigen then runs every block in the same SIMD packets as the whole
+/// array (the only scalar tail is the array's own, in the last block), so an elementwise
+/// expression gives the same bits at any split. (A split at any element put a packet's elements
+/// on the scalar path, which contracts a * b + c into FMAs differently: the bits differed
+/// between 1 and 3 threads on a Zen 3.)
+RowBlock element_block(Eigen::Index n, int parts, int i);
 
 /// How many parts a batch of `rows` is worth splitting into: one per thread, but at least
 /// `min_rows` rows each (below that, waking a thread costs more than it saves).

@@ -161,12 +161,13 @@ void Adam<T>::update(std::size_t i, Matrix<T>& p, const Matrix<T>& g) {
   const T shrink = T(1.0 - o.lr * o.weight_decay);  // AdamW's, in double as torch's
   const bool decoupled = decay != T(0) && o.decoupled_weight_decay,
              l2 = decay != T(0) && !decoupled;
-  // Elementwise, so any split into blocks gives the same bits; each block runs m, v and p while
-  // they are in cache. One fused expression per buffer: no temporaries, so no allocation.
+  // Elementwise, in blocks of whole SIMD packets (ad::element_block), so any split gives the
+  // same bits; each block runs m, v and p while they are in cache. One fused expression per
+  // buffer: no temporaries, so no allocation.
   const Eigen::Index n = p.size();
   const int parts = n >= kParallelElements ? ad::parts_for(n) : 1;
   ad::parallel_for(parts, [&](int part) {
-    const ad::RowBlock r = ad::row_block(n, parts, part);
+    const ad::RowBlock r = ad::element_block(n, parts, part);
     const auto at = [&](auto& x) { return Elements<T>(x.data() + r.begin, r.size()); };
     const Eigen::Map<const Eigen::Array<T, Eigen::Dynamic, 1>> ga(g.data() + r.begin, r.size());
     auto pa = at(p);

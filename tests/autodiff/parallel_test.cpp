@@ -83,4 +83,20 @@ TEST(ParallelFor, RethrowsTheLowestFailingPartsException) {
   EXPECT_EQ(WrongCounts(100, 2), 0) << "the pool works after failed jobs";
 }
 
+// Element blocks tile [0, n) in order and start at whole 16-element packets.
+TEST(ElementBlocks, TileTheArrayAtPacketBoundaries) {
+  for (Eigen::Index n : {0, 5, 16, 40000, 40001}) {
+    for (int parts : {1, 2, 3, 7}) {
+      Eigen::Index next = 0;
+      for (int i = 0; i < parts; ++i) {
+        const ad::RowBlock b = ad::element_block(n, parts, i);
+        EXPECT_EQ(b.begin, next) << n << " in " << parts;
+        EXPECT_EQ(b.begin % 16 == 0 || b.begin == n, true) << n << " in " << parts;
+        next = b.end;
+      }
+      EXPECT_EQ(next, n) << n << " in " << parts;
+    }
+  }
+}
+
 }  // namespace
