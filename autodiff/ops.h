@@ -148,6 +148,10 @@ Var<T> slice_cols(const Var<T>& a, Eigen::Index start, Eigen::Index count);
 /// a placed at columns [start, start + a.cols()) of a zero matrix with `cols` columns.
 template <typename T>
 Var<T> pad_cols(const Var<T>& a, Eigen::Index start, Eigen::Index cols);
+/// The same entries as rows x cols, in column-major order (Eigen's reshaped()): a row of
+/// rows * cols numbers becomes a matrix column by column.
+template <typename T>
+Var<T> reshape(const Var<T>& a, Eigen::Index rows, Eigen::Index cols);
 template <typename T>
 Var<T> concat_cols(const std::vector<Var<T>>& parts);
 /// concat_cols of a braced list, e.g. concat_cols<T>({q, p}): no vector is built (a warmed-up

@@ -1,4 +1,4 @@
-// Reductions, broadcasting and column slicing: the ops that change shapes.
+// Reductions, broadcasting, column slicing and reshaping: the ops that change shapes.
 
 #include "autodiff/op_builder.h"
 #include "autodiff/ops.h"
@@ -133,6 +133,19 @@ Var<T> pad_cols(const Var<T>& a, Eigen::Index start, Eigen::Index cols) {
   return Var<T>::of(node);
 }
 
+template <typename T>
+Var<T> reshape(const Var<T>& a, Eigen::Index rows, Eigen::Index cols) {
+  HNN_AD_CHECK(rows >= 0 && cols >= 0 && rows * cols == a.rows() * a.cols(),
+               "reshape: cannot reshape {} to {}", a.shape(), shape_str(rows, cols));
+  if (a.rows() == rows && a.cols() == cols) return a;
+  Node<T>& node =
+      detail::record<T>("reshape", {a}, [](const Node<T>& n, const Var<T>& g, GradSink<T>& s) {
+        s.add(0, reshape(g, in0(n).rows(), in0(n).cols()));
+      });
+  node.value = a.value().reshaped(rows, cols);
+  return Var<T>::of(node);
+}
+
 namespace {
 
 template <typename T>
@@ -185,6 +198,7 @@ Var<T> concat_cols(std::initializer_list<Var<T>> parts) {
   template Var<T> sum_to(const Var<T>&, Eigen::Index, Eigen::Index);       \
   template Var<T> slice_cols(const Var<T>&, Eigen::Index, Eigen::Index);   \
   template Var<T> pad_cols(const Var<T>&, Eigen::Index, Eigen::Index);     \
+  template Var<T> reshape(const Var<T>&, Eigen::Index, Eigen::Index);      \
   template Var<T> concat_cols(const std::vector<Var<T>>&);                 \
   template Var<T> concat_cols(std::initializer_list<Var<T>>);
 HNN_INSTANTIATE(float)

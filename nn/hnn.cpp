@@ -154,12 +154,12 @@ std::unique_ptr<DynamicsModel<U>> cast_model(const DynamicsModel<T>& model) {
   if (const auto* mass = dynamic_cast<const MassHnn<T>*>(&model)) {
     return std::make_unique<MassHnn<U>>(mass->template cast<U>());
   }
+  if (const auto* constrained = dynamic_cast<const ConstrainedModel<T>*>(&model)) {
+    return std::make_unique<ConstrainedModel<U>>(constrained->template cast<U>());
+  }
   Mlp<U> mlp = model.mlp().template cast<U>();
   if (model.config().model == ModelKind::kLnn) {
     return std::make_unique<Lnn<U>>(model.config(), std::move(mlp));
-  }
-  if (is_constrained(model.config().model)) {
-    return std::make_unique<ConstrainedModel<U>>(model.config(), std::move(mlp));
   }
   if (learns_scalars(model.config().model)) {
     return std::make_unique<Hnn<U>>(model.config(), std::move(mlp));

@@ -6,6 +6,7 @@
 #include "nn/autoencoder.h"
 #include "nn/constrained/constrained_model.h"
 #include "nn/constrained/constraints.h"
+#include "nn/constrained/masses.h"
 #include "nn/constrained/mechanics.h"
 #include "nn/dynamics.h"
 #include "nn/hnn.h"

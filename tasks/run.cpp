@@ -13,6 +13,7 @@
 #include "tasks/experiments/registry.h"
 #include "tasks/options/baseline_output.h"
 #include "tasks/options/fit_options.h"
+#include "tasks/options/masses.h"
 #include "tasks/report/json_values.h"
 #include "tasks/train/checkpoint.h"
 
@@ -181,6 +182,7 @@ RunSettings resolve(const Task& task, const RunOptions& o) {
   const FitConfig fit = fit_config(o.task_settings, task.name());
   check_fit_model(fit, o.model, task.name());
   given_velocities(o.task_settings, o.model, fit.samples(), velocity_state(task), task.name());
+  learned_masses(o.task_settings, o.model, task.name());
   RunSettings s{.task = task.name(),
                 .model = o.model,
                 .seed = o.seed,

@@ -14,14 +14,17 @@ namespace hnn::nn {
 
 /// config.model kChnn: the constrained Hamiltonian field (J dH projected onto the tangent space
 /// of the constraints and their time derivative, H = 1/2 p^T M^-1 p + V, p = M v); kClnn: the
-/// constrained Euler-Lagrange field. Parameters: "mlp.layers.<i>.weight|bias" of V's MLP.
+/// constrained Euler-Lagrange field. Parameters: "mlp.layers.<i>.weight|bias" of V's MLP, and
+/// with config.constraints.learned_masses "log_masses" (1 x K): M^-1 = sum_k exp(-log_masses_k)
+/// B_k (nn/constrained/masses.h), drawn as theirs, 0.1 N(0, 1) (masses near 1).
 template <typename T>
 class ConstrainedModel : public DynamicsModel<T> {
  public:
   /// config.model must be kChnn or kClnn, with its constraints. Parameters initialised from rng.
   ConstrainedModel(DynamicsConfig config, std::mt19937_64& rng);
-  /// A model with the given MLP, which must match mlp_config(config).
-  ConstrainedModel(DynamicsConfig config, Mlp<T> mlp);
+  /// A model with the given MLP, which must match mlp_config(config), and log masses (1 x K;
+  /// empty unless the config learns masses).
+  ConstrainedModel(DynamicsConfig config, Mlp<T> mlp, Matrix<T> log_masses = {});
   ConstrainedModel(ConstrainedModel&&) noexcept = default;
   ConstrainedModel& operator=(ConstrainedModel&&) noexcept = default;
 
@@ -36,14 +39,23 @@ class ConstrainedModel : public DynamicsModel<T> {
   ad::Var<T> time_derivative(const ad::Var<T>& x) const override;
 
   const ConstrainedMechanics<T>& mechanics() const { return mechanics_; }
+  /// The inverse-mass coefficients c (1 x K) the model uses: learned, or the spec's true ones.
+  Matrix<T> inverse_mass_coefficients() const;
+  void visit_parameters(const ParameterVisitor<T>& visit) override;
+  std::string describe() const override;
 
   template <typename U>
   ConstrainedModel<U> cast() const {
-    return ConstrainedModel<U>(this->config_, this->mlp_.template cast<U>());
+    return ConstrainedModel<U>(
+        this->config_, this->mlp_.template cast<U>(),
+        log_masses_.defined() ? log_masses_.value().template cast<U>() : Matrix<U>());
   }
 
  private:
+  typename ConstrainedMechanics<T>::MassOperators masses() const;
+
   ConstrainedMechanics<T> mechanics_;
+  ad::Var<T> log_masses_;  // a leaf when the masses are learned
 };
 
 }  // namespace hnn::nn

@@ -41,6 +41,10 @@ struct ConstraintSpec {
   /// N x N, symmetric positive definite (non-diagonal for rigid bodies built of points): the
   /// kinetic energy is 1/2 sum_k v[:, k]^T M v[:, k] over the axes k.
   Eigen::MatrixXd mass;
+  /// Whether a model learns the masses (nn/constrained/masses.h: `mass` then gives only the
+  /// bodies, point masses and rigid bodies, whose masses and moments are learned), as Finzi et
+  /// al.'s models do, or takes `mass` as known.
+  bool learned_masses = false;
   std::vector<Link> links;
   std::vector<Anchor> anchors;
   std::vector<Pin> pins;

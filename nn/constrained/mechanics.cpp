@@ -3,6 +3,7 @@
 #include <Eigen/Cholesky>
 
 #include "autodiff/ops.h"
+#include "nn/constrained/masses.h"
 
 namespace hnn::nn {
 
@@ -69,6 +70,28 @@ Eigen::MatrixXd gram_operator(const Eigen::MatrixXd& b_gram, const BlockRows& ro
   return gram;
 }
 
+// The operators through which M^-1 (N x N) enters the fields; each linear in M^-1.
+struct MassMatrices {
+  Eigen::MatrixXd inverse, to_velocity, gram;
+};
+
+MassMatrices mass_matrices(const Eigen::MatrixXd& minv, const Eigen::MatrixXd& b,
+                           const BlockRows& rows, Index c_count) {
+  const Eigen::MatrixXd b_gram = b * minv * b.transpose(), inverse = per_axis(minv, rows.d);
+  return {inverse, inverse * per_axis(b, rows.d).transpose(),
+          gram_operator(0.5 * (b_gram + b_gram.transpose()), rows, c_count)};
+}
+
+// Row k: basis[k]'s operator `part`, flattened column-major.
+template <typename T>
+Matrix<T> flattened(const std::vector<MassMatrices>& basis, Eigen::MatrixXd MassMatrices::*part) {
+  const Eigen::MatrixXd& first = basis.front().*part;
+  Matrix<T> out(Index(basis.size()), first.size());
+  for (std::size_t k = 0; k < basis.size(); ++k)
+    out.row(Index(k)) = (basis[k].*part).reshaped().transpose().template cast<T>();
+  return out;
+}
+
 template <typename T>
 ad::Var<T> constant(const Matrix<T>& m) {
   return ad::Var<T>::constant(m);
@@ -78,11 +101,9 @@ ad::Var<T> constant(const Matrix<T>& m) {
 
 template <typename T>
 struct ConstrainedMechanics<T>::Geometry {
-  ad::Var<T> x, v;         // R x N d
-  ad::Var<T> e, w;         // R x blocks d: e_b and w_b = de_b/dt
-  ad::Var<T> gram;         // the constant gram_
-  ad::Var<T> s;            // R x C^2: S = G M^-1 G^T
-  ad::Var<T> to_velocity;  // the constant M^-1 D^T
+  ad::Var<T> x, v;  // R x N d
+  ad::Var<T> e, w;  // R x blocks d: e_b and w_b = de_b/dt
+  ad::Var<T> s;     // R x C^2: S = G M^-1 G^T
 };
 
 template <typename T>
@@ -90,13 +111,14 @@ ConstrainedMechanics<T>::ConstrainedMechanics(const ConstraintSpec& spec) : spec
   validate(spec_);
   const Index d = spec_.dim, c_count = spec_.constraints();
   const BlockRows rows = block_rows(spec_);
-  const Eigen::MatrixXd b = incidence(spec_, true), minv = symmetric_inverse(spec_.mass);
-  const Eigen::MatrixXd b_gram = b * minv * b.transpose(), inverse = per_axis(minv, d);
+  const Eigen::MatrixXd b = incidence(spec_, true);
+  const MassMatrices known = mass_matrices(symmetric_inverse(spec_.mass), b, rows, c_count);
   mass_ = per_axis(spec_.mass, d).cast<T>();
-  inverse_ = inverse.cast<T>();
+  inverse_ = known.inverse.cast<T>();
   incidence_ = per_axis(incidence(spec_, false), d).transpose().cast<T>();
   full_incidence_ = per_axis(b, d).transpose().cast<T>();
-  inverse_incidence_ = (inverse * per_axis(b, d).transpose()).cast<T>();
+  inverse_incidence_ = known.to_velocity.cast<T>();
+  gram_ = known.gram.cast<T>();
   offsets_ = Matrix<T>::Zero(1, spec_.blocks() * d);
   group_ = Matrix<T>::Zero(spec_.blocks() * d, c_count);
   for (Index block = 0; block < spec_.blocks(); ++block) {
@@ -109,12 +131,45 @@ ConstrainedMechanics<T>::ConstrainedMechanics(const ConstraintSpec& spec) : spec
       group_(block * d + k, rows.row(block, k)) = T(1);
     }
   }
-  gram_ = gram_operator(0.5 * (b_gram + b_gram.transpose()), rows, c_count).cast<T>();
+  if (!spec_.learned_masses) return;
+  point_basis_ = inverse_mass_basis(spec_);
+  std::vector<MassMatrices> basis;
+  for (const Eigen::MatrixXd& b_k : point_basis_)
+    basis.push_back(mass_matrices(b_k, b, rows, c_count));
+  inverse_basis_ = flattened<T>(basis, &MassMatrices::inverse);
+  to_velocity_basis_ = flattened<T>(basis, &MassMatrices::to_velocity);
+  gram_basis_ = flattened<T>(basis, &MassMatrices::gram);
+}
+
+template <typename T>
+typename ConstrainedMechanics<T>::MassOperators ConstrainedMechanics<T>::known_masses() const {
+  return {constant(inverse_), constant(inverse_incidence_), constant(gram_)};
+}
+
+template <typename T>
+typename ConstrainedMechanics<T>::MassOperators ConstrainedMechanics<T>::learned_masses(
+    const ad::Var<T>& c) const {
+  HNN_AD_CHECK(spec_.learned_masses && c.rows() == 1 && c.cols() == mass_coefficients(),
+               "constrained masses: coefficients {} for {} learned masses", c.shape(),
+               mass_coefficients());
+  const auto combine = [&](const Matrix<T>& basis, const Matrix<T>& like) {
+    return ad::reshape(ad::matmul(c, constant(basis)), like.rows(), like.cols());
+  };
+  return {combine(inverse_basis_, inverse_), combine(to_velocity_basis_, inverse_incidence_),
+          combine(gram_basis_, gram_)};
+}
+
+template <typename T>
+Matrix<T> ConstrainedMechanics<T>::mass_matrix(const Matrix<T>& c) const {
+  Eigen::MatrixXd minv = Eigen::MatrixXd::Zero(spec_.points, spec_.points);
+  for (std::size_t k = 0; k < point_basis_.size(); ++k)
+    minv += double(c(0, Index(k))) * point_basis_[k];
+  return per_axis(symmetric_inverse(minv), spec_.dim).cast<T>();
 }
 
 template <typename T>
 typename ConstrainedMechanics<T>::Geometry ConstrainedMechanics<T>::geometry(
-    const ad::Var<T>& z) const {
+    const ad::Var<T>& z, const MassOperators& masses) const {
   const Index n = spec_.positions();
   HNN_AD_CHECK(z.cols() == 2 * n,
                "constrained field: states {} are not R x {} (x then v of {} "
@@ -127,9 +182,7 @@ typename ConstrainedMechanics<T>::Geometry ConstrainedMechanics<T>::geometry(
   g.e = ad::matmul(g.x, incidence);
   if (!spec_.anchors.empty() || !spec_.pins.empty()) g.e = g.e - constant(offsets_);
   g.w = ad::matmul(g.v, incidence);
-  g.gram = constant(gram_);
-  g.s = ad::matmul(ad::batched_outer(g.e, g.e), g.gram);
-  g.to_velocity = constant(inverse_incidence_);
+  g.s = ad::matmul(ad::batched_outer(g.e, g.e), masses.gram);
   return g;
 }
 
@@ -144,44 +197,44 @@ ad::Var<T> ConstrainedMechanics<T>::expand(const ad::Var<T>& l) const {
 }
 
 template <typename T>
-ad::Var<T> ConstrainedMechanics<T>::hamiltonian_field(const ad::Var<T>& z,
-                                                      const ad::Var<T>& dv) const {
-  const Geometry g = geometry(z);
-  const ad::Var<T> free_acceleration = -ad::matmul(dv, constant(inverse_));
+ad::Var<T> ConstrainedMechanics<T>::hamiltonian_field(const ad::Var<T>& z, const ad::Var<T>& dv,
+                                                      const MassOperators& masses) const {
+  const Geometry g = geometry(z, masses);
+  const ad::Var<T> free_acceleration = -ad::matmul(dv, masses.inverse);
   if (spec_.constraints() == 0) return ad::concat_cols<T>({g.v, free_acceleration});
   // DPsi f = (r1, r2) = (G v, Gdot v - G M^-1 dV). A pin's G v is its e's rate, which w leaves
   // out (its Gdot is zero).
   const ad::Var<T> rate = spec_.pins.empty() ? g.w : ad::matmul(g.v, constant(full_incidence_));
   const ad::Var<T> r1 = group(g.e * rate);
-  const ad::Var<T> r2 = group(g.w * g.w - g.e * ad::matmul(dv, g.to_velocity));
+  const ad::Var<T> r2 = group(g.w * g.w - g.e * ad::matmul(dv, masses.to_velocity));
   const ad::Var<T> k =
-      ad::matmul(ad::batched_outer(g.w, g.e) - ad::batched_outer(g.e, g.w), g.gram);
+      ad::matmul(ad::batched_outer(g.w, g.e) - ad::batched_outer(g.e, g.w), masses.gram);
   const ad::Var<T> nu = ad::batched_spd_solve(g.s, r1);  // S nu = r1
   const ad::Var<T> mu = ad::batched_spd_solve(g.s, ad::batched_matvec(k, nu) - r2);
   // z' = f - J DPsi^T (mu, nu): x' = v - M^-1 G^T nu, p' = -dV + G^T mu + Gdot^T nu.
   const ad::Var<T> nu_e = g.e * expand(nu);
-  const ad::Var<T> x_dot = g.v - ad::matmul(nu_e, g.to_velocity, false, true);
+  const ad::Var<T> x_dot = g.v - ad::matmul(nu_e, masses.to_velocity, false, true);
   const ad::Var<T> v_dot = free_acceleration + ad::matmul(g.e * expand(mu) + g.w * expand(nu),
-                                                          g.to_velocity, false, true);
+                                                          masses.to_velocity, false, true);
   return ad::concat_cols<T>({x_dot, v_dot});
 }
 
 template <typename T>
-ad::Var<T> ConstrainedMechanics<T>::lagrangian_field(const ad::Var<T>& z,
-                                                     const ad::Var<T>& dv) const {
-  const Geometry g = geometry(z);
-  const ad::Var<T> free_acceleration = -ad::matmul(dv, constant(inverse_));
+ad::Var<T> ConstrainedMechanics<T>::lagrangian_field(const ad::Var<T>& z, const ad::Var<T>& dv,
+                                                     const MassOperators& masses) const {
+  const Geometry g = geometry(z, masses);
+  const ad::Var<T> free_acceleration = -ad::matmul(dv, masses.inverse);
   if (spec_.constraints() == 0) return ad::concat_cols<T>({g.v, free_acceleration});
-  const ad::Var<T> rhs = group(g.w * g.w - g.e * ad::matmul(dv, g.to_velocity));
+  const ad::Var<T> rhs = group(g.w * g.w - g.e * ad::matmul(dv, masses.to_velocity));
   const ad::Var<T> lambda = ad::batched_spd_solve(g.s, rhs);
   const ad::Var<T> a =
-      free_acceleration - ad::matmul(g.e * expand(lambda), g.to_velocity, false, true);
+      free_acceleration - ad::matmul(g.e * expand(lambda), masses.to_velocity, false, true);
   return ad::concat_cols<T>({g.v, a});
 }
 
 template <typename T>
-Matrix<T> ConstrainedMechanics<T>::kinetic_energy(const Matrix<T>& v) const {
-  return (T(0.5) * (v * mass_).cwiseProduct(v).rowwise().sum()).eval();
+Matrix<T> ConstrainedMechanics<T>::kinetic_energy(const Matrix<T>& v, const Matrix<T>* mass) const {
+  return (T(0.5) * (v * (mass ? *mass : mass_)).cwiseProduct(v).rowwise().sum()).eval();
 }
 
 template class ConstrainedMechanics<float>;

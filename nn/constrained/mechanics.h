@@ -22,27 +22,46 @@ namespace hnn::nn {
 template <typename T>
 class ConstrainedMechanics {
  public:
-  /// Validates `spec` (std::invalid_argument) and forms its constant operators.
+  /// Validates `spec` (std::invalid_argument) and forms its constant operators; with
+  /// spec.learned_masses also the basis of M^-1 (nn/constrained/masses.h).
   explicit ConstrainedMechanics(const ConstraintSpec& spec);
+
+  /// The operators through which M^-1 enters the fields, all linear in it: M^-1 (x) I_d
+  /// (N d x N d), M^-1 D^T (N d x blocks d) and the Gram operator of S (see gram_operator).
+  struct MassOperators {
+    ad::Var<T> inverse, to_velocity, gram;
+  };
+  /// The spec's masses, as constants.
+  MassOperators known_masses() const;
+  /// M^-1 = sum_k c_k B_k for c (1 x K, on the tape: gradients reach it), B_k the
+  /// spec's inverse_mass_basis. Needs spec.learned_masses.
+  MassOperators learned_masses(const ad::Var<T>& c) const;
+  /// K, the size of c (0 unless spec.learned_masses).
+  Eigen::Index mass_coefficients() const { return Eigen::Index(point_basis_.size()); }
+  /// M (x) I_d for coefficients c (values), to weigh kinetic energies.
+  Matrix<T> mass_matrix(const Matrix<T>& c) const;
 
   /// The CHNN field in (x, v) coordinates for states z (R x 2 N d) and dV/dx (R x N d):
   /// z' = f - J DPsi^T (DPsi J DPsi^T)^-1 DPsi f in (x, p = M v), f = J dH, then v' = M^-1 p'.
   /// DPsi J DPsi^T = [[0, S], [-S, K]], K = Gdot M^-1 G^T - G M^-1 Gdot^T, is solved by two SPD
   /// solves of S (ad::batched_spd_solve). On the constraint manifold x' = v; off it, x' is
   /// projected too, and DPsi z' = 0 still holds.
-  ad::Var<T> hamiltonian_field(const ad::Var<T>& z, const ad::Var<T>& dv) const;
+  ad::Var<T> hamiltonian_field(const ad::Var<T>& z, const ad::Var<T>& dv,
+                               const MassOperators& masses) const;
   /// The CLNN field (v, a): M a = -dV/dx - G^T lambda, lambda = S^-1 (Gdot v - G M^-1 dV/dx), so
   /// that G a + Gdot v = 0. Equal to hamiltonian_field on the constraint manifold.
-  ad::Var<T> lagrangian_field(const ad::Var<T>& z, const ad::Var<T>& dv) const;
+  ad::Var<T> lagrangian_field(const ad::Var<T>& z, const ad::Var<T>& dv,
+                              const MassOperators& masses) const;
 
-  /// The kinetic energy 1/2 sum_k v[:, k]^T M v[:, k], R x 1 (values).
-  Matrix<T> kinetic_energy(const Matrix<T>& v) const;
+  /// The kinetic energy 1/2 sum_k v[:, k]^T M v[:, k], R x 1 (values), M (x) I_d = `mass`
+  /// (the spec's mass_ by default).
+  Matrix<T> kinetic_energy(const Matrix<T>& v, const Matrix<T>* mass = nullptr) const;
 
   const ConstraintSpec& spec() const { return spec_; }
 
  private:
   struct Geometry;  // E, W and the Gram blocks of one batch
-  Geometry geometry(const ad::Var<T>& z) const;
+  Geometry geometry(const ad::Var<T>& z, const MassOperators& masses) const;
   ad::Var<T> group(const ad::Var<T>& y) const;   // R x blocks d -> R x C: sums a distance's axes
   ad::Var<T> expand(const ad::Var<T>& l) const;  // R x C -> R x blocks d: its adjoint
 
@@ -55,6 +74,10 @@ class ConstrainedMechanics {
   Matrix<T> offsets_;            // 1 x blocks d: an anchor's point, -1 on a pin's axes (E = 1)
   Matrix<T> group_;  // blocks d x C: 1 where block b's axis k meets its constraint's row
   Matrix<T> gram_;   // (blocks d)^2 x C^2: see gram_operator in mechanics.cpp
+  // With learned masses: row k holds inverse_, inverse_incidence_ and gram_ of B_k, flattened
+  // column-major, so that c times them is each operator at M^-1 = sum_k c_k B_k.
+  Matrix<T> inverse_basis_, to_velocity_basis_, gram_basis_;
+  std::vector<Eigen::MatrixXd> point_basis_;  // B_k, N x N
 };
 
 }  // namespace hnn::nn

@@ -34,15 +34,30 @@ SplitBy parse_split(const std::string& name) {
 }  // namespace
 
 const std::vector<std::string>& data_setting_names() {
-  static const std::vector<std::string> names = {
-      "coords",       "momenta",        "velocities",
-      "derivatives",  "time",           "trajectory",
-      "split",        "test_fraction",  "gap_factor",
-      "hamiltonian",  "standardize",    "threshold",
-      "rollouts",     "t_end",          "loss",
-      "horizon",      "integrator",     "dt",
-      "norm",         "minibatches",    "energy_rollouts",
-      "energy_t_end", "baseline_output"};
+  static const std::vector<std::string> names = {"coords",
+                                                 "momenta",
+                                                 "velocities",
+                                                 "derivatives",
+                                                 "time",
+                                                 "trajectory",
+                                                 "split",
+                                                 "test_fraction",
+                                                 "gap_factor",
+                                                 "hamiltonian",
+                                                 "standardize",
+                                                 "threshold",
+                                                 "rollouts",
+                                                 "t_end",
+                                                 "loss",
+                                                 "horizon",
+                                                 "integrator",
+                                                 "dt",
+                                                 "norm",
+                                                 "minibatches",
+                                                 "energy_rollouts",
+                                                 "energy_t_end",
+                                                 "baseline_output",
+                                                 "masses"};
   static const std::vector<std::string> with_fit = [] {
     std::vector<std::string> all = names;
     all.insert(all.end(), fit_setting_names().begin(), fit_setting_names().end());

@@ -15,6 +15,7 @@
 #include "tasks/evaluate/held_out.h"
 #include "tasks/field/field_model_run.h"
 #include "tasks/options/baseline_output.h"
+#include "tasks/options/masses.h"
 #include "tasks/report/json_values.h"
 #include "tasks/report/rollout_csv.h"
 
@@ -25,11 +26,14 @@ namespace {
 using nlohmann::json;
 
 ModelInput model_input(const FieldTask& task, const RunSettings& s) {
+  nn::ConstraintSpec constraints =
+      nn::is_constrained(s.model) ? task.constraints() : nn::ConstraintSpec{};
+  constraints.learned_masses = learned_masses(s.task_settings, s.model, task.name());
   return {.angles = task.angle_coordinates(),
           .input_scale = task.input_scale(),
           .given_velocities = given_velocities(s.task_settings, s.model, s.fit.samples(),
                                                velocity_state(task), task.name()),
-          .constraints = nn::is_constrained(s.model) ? task.constraints() : nn::ConstraintSpec{}};
+          .constraints = std::move(constraints)};
 }
 
 class FieldRun : public FieldModelRun {
@@ -250,6 +254,7 @@ void FieldTask::check_task_settings(const nlohmann::json& settings) const {
   const std::vector<std::string> own = own_setting_names(), rollouts = evaluation_setting_names();
   std::vector<std::string> known = rollout_setting_names();
   known.push_back(kBaselineOutputKey);
+  known.push_back(kMassesKey);
   known.insert(known.end(), fit_setting_names().begin(), fit_setting_names().end());
   known.insert(known.end(), own.begin(), own.end());
   known.insert(known.end(), rollouts.begin(), rollouts.end());

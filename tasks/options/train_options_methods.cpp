@@ -4,6 +4,7 @@
 
 #include "tasks/integrate/integrator_step.h"
 #include "tasks/options/baseline_output.h"
+#include "tasks/options/masses.h"
 #include "tasks/options/train_options.h"
 #include "tasks/train/fit_method.h"
 #include "tasks/train/rollout_objective.h"
@@ -154,6 +155,15 @@ const TrainOption kMethodOptions[] = {
      .key = "baseline_output",
      .choices = baseline_output_names,
      .noun = "baseline output"},
+    {.name = "masses",
+     .kind = ValueKind::kChoice,
+     .help = "Whether a chnn or clnn takes its system's masses as known (the default) or learns "
+             "them, each body's mass and moments, as Finzi et al.'s models do (learned)",
+     .sweep_rank = 37,
+     .applies_to = AppliesTo::kFieldTasks,
+     .key = "masses",
+     .choices = masses_names,
+     .noun = "masses"},
 };
 
 }  // namespace

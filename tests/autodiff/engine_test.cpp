@@ -376,6 +376,7 @@ std::vector<ShapeErrorCase> ShapeErrorCases() {
       {"SumTo", [] { ad::sum_to(Leaf(2, 3), 2, 2); }, {"sum_to", "2x3", "2x2"}},
       {"SliceCols", [] { ad::slice_cols(Leaf(2, 3), 2, 2); }, {"slice_cols", "2x3", "[2, 4)"}},
       {"PadCols", [] { ad::pad_cols(Leaf(2, 3), 1, 3); }, {"pad_cols", "2x3"}},
+      {"Reshape", [] { ad::reshape(Leaf(2, 3), 4, 2); }, {"reshape", "2x3", "4x2"}},
   };
 }
 

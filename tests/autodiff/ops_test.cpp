@@ -127,6 +127,9 @@ void AddUnaryCases(std::vector<OpCase>& cases) {
   unary("SliceCols", Any(3, 4, 45), [](const VarD& x) { return ad::slice_cols(x, 1, 2); });
   unary("SliceAllCols", Any(3, 4, 46), [](const VarD& x) { return ad::slice_cols(x, 0, 4); });
   unary("PadCols", Any(3, 2, 47), [](const VarD& x) { return ad::pad_cols(x, 1, 5); });
+  unary("Reshape", Any(1, 12, 149), [](const VarD& x) { return ad::reshape(x, 3, 4); });
+  unary("ReshapeSquared", Any(3, 4, 150),
+        [](const VarD& x) { return ad::square(ad::reshape(x, 2, 6)); });
   unary("ConcatSelf", Any(3, 2, 48), [](const VarD& x) {
     return ad::concat_cols<double>({x, ad::sin(x), x});
   });
@@ -320,6 +323,12 @@ TEST(ShapeOps, NarrowSlicesPadsAndJoinsCopyTheirColumnsExactly) {
   const MatrixD joined = ad::concat_cols<double>({ad::slice_cols(v, 2, 1), v}).value();
   EXPECT_EQ(joined.col(0), x.col(2));
   EXPECT_EQ(joined.rightCols(3), x);
+}
+
+TEST(ShapeOps, ReshapeKeepsColumnMajorOrder) {
+  const MatrixD x = random_matrix(1, 6, 8);
+  const MatrixD y = ad::reshape(VarD::constant(x), 2, 3).value();
+  for (int k = 0; k < 6; ++k) EXPECT_EQ(y(k % 2, k / 2), x(0, k));
 }
 
 // A broadcast error names the op and both shapes (formatted only when it is thrown).

@@ -141,8 +141,8 @@ TEST(ConstrainedFields, EqualTheExactMotionOfOneAndTwoLinkPendulums) {
         chain_spec(lengths[c], 2, diag.asDiagonal(), pivot));
     ad::TapeScope scope;
     const Var<double> z = Var<double>::constant(exact.z), dv = Var<double>::constant(exact.dv);
-    const MatrixD h = mechanics.hamiltonian_field(z, dv).value();
-    const MatrixD l = mechanics.lagrangian_field(z, dv).value();
+    const MatrixD h = mechanics.hamiltonian_field(z, dv, mechanics.known_masses()).value();
+    const MatrixD l = mechanics.lagrangian_field(z, dv, mechanics.known_masses()).value();
     const double scale = exact.zdot.cwiseAbs().maxCoeff();
     EXPECT_LT((h - exact.zdot).cwiseAbs().maxCoeff(), 1e-12 * scale)
         << masses[c].size() << " links";
@@ -175,9 +175,13 @@ TEST(ConstrainedFields, APinnedPivotHoldsItsPointAndSwingsTheOther) {
   ad::TapeScope scope;
   const Var<double> zv = Var<double>::constant(z), dvv = Var<double>::constant(dv);
   const double scale = zdot.cwiseAbs().maxCoeff();
-  EXPECT_LT((mechanics.hamiltonian_field(zv, dvv).value() - zdot).cwiseAbs().maxCoeff(),
+  EXPECT_LT((mechanics.hamiltonian_field(zv, dvv, mechanics.known_masses()).value() - zdot)
+                .cwiseAbs()
+                .maxCoeff(),
             1e-12 * scale);
-  EXPECT_LT((mechanics.lagrangian_field(zv, dvv).value() - zdot).cwiseAbs().maxCoeff(),
+  EXPECT_LT((mechanics.lagrangian_field(zv, dvv, mechanics.known_masses()).value() - zdot)
+                .cwiseAbs()
+                .maxCoeff(),
             1e-12 * scale);
 }
 

@@ -81,10 +81,10 @@ TEST(ConstrainedTraining, MechanicsDifferentiateInStateAndPotentialGradient) {
         spec.pins.empty() ? nn::testing::chain_states(spec, 2, 24) : pinned_pair_states(rng),
         nn::random_uniform<double>(2, 4, rng, -1, 1)};
     const auto hamiltonian = [&](const std::vector<Var<double>>& in) {
-      return ad::sum(ad::sin(mechanics.hamiltonian_field(in[0], in[1])));
+      return ad::sum(ad::sin(mechanics.hamiltonian_field(in[0], in[1], mechanics.known_masses())));
     };
     const auto lagrangian = [&](const std::vector<Var<double>>& in) {
-      return ad::sum(ad::sin(mechanics.lagrangian_field(in[0], in[1])));
+      return ad::sum(ad::sin(mechanics.lagrangian_field(in[0], in[1], mechanics.known_masses())));
     };
     for (const ad::CheckResult& check :
          {ad::gradcheck(hamiltonian, inputs), ad::gradgradcheck(hamiltonian, inputs),
@@ -103,8 +103,10 @@ TEST(ConstrainedTraining, ATinyRunOnACartesianPendulumReducesTheLoss) {
   dv.col(1).setOnes();
   const MatrixD target = [&] {
     ad::TapeScope scope;
-    return nn::ConstrainedMechanics<double>(spec)
-        .hamiltonian_field(Var<double>::constant(z), Var<double>::constant(dv))
+    const nn::ConstrainedMechanics<double> mechanics(spec);
+    return mechanics
+        .hamiltonian_field(Var<double>::constant(z), Var<double>::constant(dv),
+                           mechanics.known_masses())
         .value();
   }();
   std::mt19937_64 rng(32);

@@ -56,7 +56,7 @@ std::vector<BadOption> bad_train_options() {
        "real-pendulum)"},
       {{"train", "spring", "--settings", "{\"trials\": 20}"},
        "task 'spring' has no setting 'trials' (known: loss, horizon, integrator, dt, norm, "
-       "minibatches, baseline_output, fit, sampler, rcond, solver, regularization, "
+       "minibatches, baseline_output, masses, fit, sampler, rcond, solver, regularization, "
        "solver_tolerance, "
        "solver_iterations, sample_dt, "
        "t_end, rollouts, rollout_t_end)"},
@@ -276,7 +276,7 @@ TEST(TrainOptionsTable, TheSweepKeysAreItsRowsInRankOrderAndTheOthersAreRefusedW
       "minibatches": "epochs",
       "fit": "sampled+adam", "sampler": "aswim", "rcond": 1e-10, "solver": "qr",
       "regularization": 1e-9, "solver-tolerance": 1e-10, "solver-iterations": 50,
-      "baseline-output": "field"})");
+      "baseline-output": "field", "masses": "known"})");
   json spec = json::object();
   std::vector<const TrainOption*> keys;
   for (const TrainOption& option : tasks::train_options()) {

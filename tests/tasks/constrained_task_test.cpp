@@ -7,6 +7,7 @@
 
 #include <cmath>
 
+#include "nn/constrained/constrained_model.h"
 #include "nn/mass_hnn.h"
 #include "physics/constrained/chain_angles.h"
 #include "physics/constrained/metric.h"
@@ -193,6 +194,39 @@ TEST(ConstrainedTask, TheConstrainedModelsTrainOnTheSystemsOwnConstraints) {
       EXPECT_LT(system.constraint_values(path).cwiseAbs().maxCoeff(), 1e-5) << task << model;
     }
   }
+}
+
+// --masses learned: the CHNN learns each body's mass (the chain's points) or mass and moments (the
+// gyroscope's rigid body) with V, from 0.1 N(0, 1) log masses; the run loads back with them. Models
+// without a mass matrix of their own refuse the option.
+TEST(ConstrainedTask, TheConstrainedModelsLearnTheirMassesWhenAsked) {
+  TempDir dir("runs");
+  for (const auto& [task, count] : {std::pair{"chain-pendulum-2", 2}, std::pair{"gyroscope", 4}}) {
+    RunOptions o = tiny("chnn", dir / task, task);
+    o.task_settings["masses"] = "learned";
+    const nlohmann::json m = run_training(o);
+    EXPECT_EQ(m["cartesian_error_failed"], 0) << task;
+    const LoadedRun loaded = load_run(dir / task);
+    const auto* model = dynamic_cast<const nn::ConstrainedModel<double>*>(&loaded.run->dynamics());
+    ASSERT_NE(model, nullptr) << task;
+    EXPECT_TRUE(model->config().constraints.learned_masses) << task;
+    const Batch c = model->inverse_mass_coefficients();
+    ASSERT_EQ(c.cols(), count) << task;
+    EXPECT_GT(c.minCoeff(), 0.5) << task;
+    EXPECT_LT(c.maxCoeff(), 2.0) << task;
+    EXPECT_NE(model->describe().find("learned masses"), std::string::npos) << task;
+  }
+  RunOptions hnn = tiny("hnn", dir / "h");
+  hnn.task_settings["masses"] = "learned";
+  try {
+    run_training(hnn);
+    FAIL() << "an HNN took --masses learned";
+  } catch (const Error& e) {
+    EXPECT_STREQ(e.what(),
+                 "chain-pendulum-2: --masses learned applies to --model chnn and clnn only, not "
+                 "hnn");
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir / "h"));
 }
 
 TEST(ConstrainedTask, RefusesAngleModelsWhereHnnHasNoAngles) {
