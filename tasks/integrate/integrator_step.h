@@ -29,10 +29,12 @@
 
 namespace hnn::tasks {
 
-enum class RolloutIntegrator { kRk4, kLeapfrog, kYoshida4, kMidpoint };
+/// kRk38 is Kutta's 3/8 rule, the fourth-order RK that torchdiffeq's "rk4" runs
+/// (rk4_alt_step_func), so the peers' rollout losses through "rk4" are that method.
+enum class RolloutIntegrator { kRk4, kLeapfrog, kYoshida4, kMidpoint, kRk38 };
 
 std::string_view to_string(RolloutIntegrator integrator);
-/// Throws Error naming the four valid names.
+/// Throws Error naming the valid names.
 RolloutIntegrator parse_rollout_integrator(std::string_view name);
 std::vector<std::string> rollout_integrator_names();
 

@@ -52,7 +52,7 @@ TEST(RolloutCli, TrainsThroughLeapfrogAndRefusesBadSettingsInOneLine) {
        "--dt 0.3 does not divide the sampling interval (0.5) into whole steps: use the interval "
        "divided by a whole number\n"},
       {{"train", "spring", "--loss", "rollout", "--integrator", "euler"},
-       "--integrator: euler not in {leapfrog,yoshida4,midpoint,rk4}"},
+       "--integrator: euler not in {leapfrog,yoshida4,midpoint,rk4,rk4-38}"},
       {{"train", "spring", "--loss", "sideways"}, "--loss: sideways not in {derivative,rollout}"},
       {{"train", "damped-spring", "--loss", "rollout"},
        "damped-spring: the rollout loss needs trajectories, and this task's data are states "

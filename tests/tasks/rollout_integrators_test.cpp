@@ -90,7 +90,23 @@ TEST(RolloutIntegrators, HaveTheirOrdersOnSeparableSystems) {
     EXPECT_NEAR(measured_order(model, RolloutIntegrator::kMidpoint, 16), 2.0, 0.15);
     EXPECT_NEAR(measured_order(model, RolloutIntegrator::kYoshida4, 8), 4.0, 0.3);
     EXPECT_NEAR(measured_order(model, RolloutIntegrator::kRk4, 8), 4.0, 0.3);
+    EXPECT_NEAR(measured_order(model, RolloutIntegrator::kRk38, 8), 4.0, 0.3);
   }
+}
+
+// Kutta's 3/8 rule (torchdiffeq's "rk4") by its tableau, one step of the pendulum's field by
+// hand; on a nonlinear field it is not the classic RK4.
+TEST(RolloutIntegrators, TheThreeEighthsRuleIsKuttasTableau) {
+  const KnownField model = pendulum();
+  const Matrix x0{{0.9, -0.3}};
+  const double h = 0.2;
+  const auto f = [&](const Matrix& x) { return model.field(x); };
+  const Matrix k1 = f(x0), k2 = f(x0 + h / 3 * k1), k3 = f(x0 + h * (k2 - k1 / 3)),
+               k4 = f(x0 + h * (k1 - k2 + k3));
+  const Matrix want = x0 + h / 8 * (k1 + 3 * k2 + 3 * k3 + k4);
+  const Matrix got = run(model, RolloutIntegrator::kRk38, x0, h, 1);
+  EXPECT_LT((got - want).cwiseAbs().maxCoeff(), 1e-15);
+  EXPECT_GT((got - run(model, RolloutIntegrator::kRk4, x0, h, 1)).cwiseAbs().maxCoeff(), 1e-7);
 }
 
 // Not separable: the midpoint keeps order 2 and RK4 order 4; the explicit kick-drift-kick drops
@@ -99,6 +115,7 @@ TEST(RolloutIntegrators, OnANonSeparableFieldLeapfrogIsFirstOrder) {
   const KnownField model = coupled();
   EXPECT_NEAR(measured_order(model, RolloutIntegrator::kMidpoint, 16), 2.0, 0.15);
   EXPECT_NEAR(measured_order(model, RolloutIntegrator::kRk4, 8), 4.0, 0.3);
+  EXPECT_NEAR(measured_order(model, RolloutIntegrator::kRk38, 8), 4.0, 0.3);
   EXPECT_NEAR(measured_order(model, RolloutIntegrator::kLeapfrog, 64), 1.0, 0.15);
   EXPECT_NEAR(measured_order(model, RolloutIntegrator::kYoshida4, 64), 1.0, 0.2);
 }
