@@ -11,9 +11,8 @@
 #include "tasks/data/file_digest.h"
 #include "tasks/data/initial_states.h"
 #include "tasks/experiments/registry.h"
-#include "tasks/options/baseline_output.h"
 #include "tasks/options/fit_options.h"
-#include "tasks/options/masses.h"
+#include "tasks/options/model_settings.h"
 #include "tasks/report/json_values.h"
 #include "tasks/train/checkpoint.h"
 

@@ -85,11 +85,10 @@ Matrix<T> ConstrainedModel<T>::energy(const Matrix<T>& x) const {
   ad::TapeScope scope;
   ad::NoGradGuard values_only;
   const Matrix<T> v = x.rightCols(x.cols() / 2);
-  Matrix<T> kinetic = mechanics_.kinetic_energy(v);
-  if (log_masses_.defined()) {
-    const Matrix<T> mass = mechanics_.mass_matrix(inverse_mass_coefficients());
-    kinetic = mechanics_.kinetic_energy(v, &mass);
-  }
+  const Matrix<T> kinetic =
+      log_masses_.defined()
+          ? mechanics_.kinetic_energy(v, mechanics_.mass_matrix(inverse_mass_coefficients()))
+          : mechanics_.kinetic_energy(v, mechanics_.mass());
   return (kinetic + potential(ad::Var<T>::constant(x)).value()).eval();
 }
 

@@ -96,25 +96,24 @@ std::vector<Term> terms(const ConstraintSpec& spec) {
   return out;
 }
 
-}  // namespace
-
-std::vector<Eigen::MatrixXd> inverse_mass_basis(const ConstraintSpec& spec) {
-  inverse_mass_coefficients(spec);  // refuses a mass matrix that is not a positive sum of them
+// The basis and its coefficients, checked: sum_k c_k B_k = M^-1 with every c_k > 0.
+struct Decomposition {
   std::vector<Eigen::MatrixXd> basis;
-  for (Term& t : terms(spec)) basis.push_back(std::move(t.basis));
-  return basis;
-}
+  Eigen::VectorXd coefficients;
+};
 
-Eigen::VectorXd inverse_mass_coefficients(const ConstraintSpec& spec) {
+Decomposition decompose(const ConstraintSpec& spec) {
   const std::vector<Term> all = terms(spec);
   const Eigen::MatrixXd inverse =
       spec.mass.llt().solve(Eigen::MatrixXd::Identity(spec.points, spec.points));
-  Eigen::VectorXd c(Index(all.size()));
+  Decomposition out{{}, Eigen::VectorXd(Index(all.size()))};
+  Eigen::VectorXd& c = out.coefficients;
   Eigen::MatrixXd sum = Eigen::MatrixXd::Zero(spec.points, spec.points);
   for (Index k = 0; k < c.size(); ++k) {
     const Term& t = all[std::size_t(k)];
     c[k] = inverse(t.at, t.at) - (t.less < 0 ? 0.0 : inverse(t.less, t.less));
     sum += c[k] * t.basis;
+    out.basis.push_back(t.basis);
   }
   const double miss = (sum - inverse).cwiseAbs().maxCoeff();
   if (miss > 1e-9 * inverse.cwiseAbs().maxCoeff() || (c.array() <= 0).any()) {
@@ -123,7 +122,17 @@ Eigen::VectorXd inverse_mass_coefficients(const ConstraintSpec& spec) {
                     "(off by {:.3g}; coefficients {})",
                     miss, fmt::join(c.data(), c.data() + c.size(), ", ")));
   }
-  return c;
+  return out;
+}
+
+}  // namespace
+
+std::vector<Eigen::MatrixXd> inverse_mass_basis(const ConstraintSpec& spec) {
+  return decompose(spec).basis;
+}
+
+Eigen::VectorXd inverse_mass_coefficients(const ConstraintSpec& spec) {
+  return decompose(spec).coefficients;
 }
 
 }  // namespace hnn::nn

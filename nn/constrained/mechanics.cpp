@@ -233,8 +233,8 @@ ad::Var<T> ConstrainedMechanics<T>::lagrangian_field(const ad::Var<T>& z, const 
 }
 
 template <typename T>
-Matrix<T> ConstrainedMechanics<T>::kinetic_energy(const Matrix<T>& v, const Matrix<T>* mass) const {
-  return (T(0.5) * (v * (mass ? *mass : mass_)).cwiseProduct(v).rowwise().sum()).eval();
+Matrix<T> ConstrainedMechanics<T>::kinetic_energy(const Matrix<T>& v, const Matrix<T>& mass) {
+  return (T(0.5) * (v * mass).cwiseProduct(v).rowwise().sum()).eval();
 }
 
 template class ConstrainedMechanics<float>;

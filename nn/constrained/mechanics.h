@@ -53,9 +53,11 @@ class ConstrainedMechanics {
   ad::Var<T> lagrangian_field(const ad::Var<T>& z, const ad::Var<T>& dv,
                               const MassOperators& masses) const;
 
-  /// The kinetic energy 1/2 sum_k v[:, k]^T M v[:, k], R x 1 (values), M (x) I_d = `mass`
-  /// (the spec's mass_ by default).
-  Matrix<T> kinetic_energy(const Matrix<T>& v, const Matrix<T>* mass = nullptr) const;
+  /// The kinetic energy 1/2 sum_k v[:, k]^T M v[:, k], R x 1 (values), for M (x) I_d = `mass`:
+  /// mass() or a mass_matrix(c).
+  static Matrix<T> kinetic_energy(const Matrix<T>& v, const Matrix<T>& mass);
+  /// The spec's M (x) I_d.
+  const Matrix<T>& mass() const { return mass_; }
 
   const ConstraintSpec& spec() const { return spec_; }
 

@@ -14,7 +14,7 @@
 namespace hnn::tasks {
 
 /// How the models see their inputs (angle coordinates, input scales), as the task says, and
-/// whether a baseline is given its velocities (tasks/options/baseline_output.h).
+/// whether a baseline is given its velocities (tasks/options/model_settings.h).
 struct ModelInput {
   Eigen::Index angles = 0;
   std::vector<double> input_scale{};

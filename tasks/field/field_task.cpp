@@ -14,8 +14,7 @@
 #include "tasks/evaluate/field_evaluation.h"
 #include "tasks/evaluate/held_out.h"
 #include "tasks/field/field_model_run.h"
-#include "tasks/options/baseline_output.h"
-#include "tasks/options/masses.h"
+#include "tasks/options/model_settings.h"
 #include "tasks/report/json_values.h"
 #include "tasks/report/rollout_csv.h"
 

@@ -3,8 +3,7 @@
 // baseline's MLP gives. train_options() puts them after the rows of train_options.cpp.
 
 #include "tasks/integrate/integrator_step.h"
-#include "tasks/options/baseline_output.h"
-#include "tasks/options/masses.h"
+#include "tasks/options/model_settings.h"
 #include "tasks/options/train_options.h"
 #include "tasks/train/fit_method.h"
 #include "tasks/train/rollout_objective.h"
