@@ -17,19 +17,7 @@ build_dir=${HNN_FUZZ_BUILD_DIR:-build-fuzz}
 jobs=${HNN_JOBS:-$(nproc)}
 names=("$@")
 [ ${#names[@]} -gt 0 ] || names=(lipson params train_state table)
-scripts/setup.sh
-# clang and its libFuzzer runtime, installed only if missing (as setup.sh does for the rest).
-missing=()
-for p in clang libclang-rt-dev; do
-  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
-done
-if [ ${#missing[@]} -gt 0 ]; then
-  echo "fuzz.sh: installing ${missing[*]}"
-  sudo=""
-  [ "$(id -u)" -eq 0 ] || sudo="sudo"
-  $sudo apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
-fi
+scripts/setup.sh clang libclang-rt-dev  # clang and its libFuzzer runtime
 
 CC=clang CXX=clang++ cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DHNN_FUZZ=ON \
   -DHNN_BUILD_TESTS=OFF -DHNN_BUILD_BENCH=OFF -DHNN_BUILD_APPS=OFF >/dev/null

@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Installs the Debian packages hnn needs, only those missing. Safe to re-run.
+# Installs the Debian packages hnn needs, only those missing, and any packages named as arguments
+# (scripts/sanitize.sh and fuzz.sh add clang). Safe to re-run.
 source "$(dirname "$0")/help.sh"
 set -euo pipefail
 
@@ -11,6 +12,7 @@ packages=(
   libssl-dev
   python3-matplotlib python3-numpy python3-distributed
   pybind11-dev python3-dev python3-pytest
+  "$@"
 )
 
 missing=()

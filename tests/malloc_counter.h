@@ -4,7 +4,18 @@
 
 #include <cstddef>  // brings in <features.h>, which defines __GLIBC__
 
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__) || !defined(__GLIBC__)
+// Whether a sanitizer owns malloc: GCC says so with __SANITIZE_ADDRESS__, clang with __has_feature.
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+#define HNN_SANITIZED_MALLOC 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer)
+#define HNN_SANITIZED_MALLOC 1
+#endif
+#endif
+#ifndef HNN_SANITIZED_MALLOC
+#define HNN_SANITIZED_MALLOC 0
+#endif
+#if HNN_SANITIZED_MALLOC || !defined(__GLIBC__)
 #define HNN_COUNTS_ALLOCATIONS 0
 #else
 #define HNN_COUNTS_ALLOCATIONS 1

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "autodiff/autodiff.h"
+#include "malloc_counter.h"
 #include "test_util.h"
 
 namespace ad = hnn::ad;
@@ -61,7 +62,7 @@ TEST(TapeMemory, ThousandScopedTrainingStepsKeepTheTapeAndRssFlat) {
   // One unreleased step of this model holds ~0.4 MB of node values (measured), so 980 leaked
   // steps would show as ~400 MB; allow a little allocator noise. Not under AddressSanitizer,
   // whose quarantine holds freed blocks (up to 256 MB): there LeakSanitizer checks instead.
-#if !defined(__SANITIZE_ADDRESS__)
+#if !HNN_SANITIZED_MALLOC
   EXPECT_LT(growth, 1 << 20) << "RSS grew by " << growth << " bytes over 980 steps";
 #endif
   EXPECT_LT(loss, 0.05 * first_loss)

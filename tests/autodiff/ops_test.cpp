@@ -64,7 +64,7 @@ void AddBinaryCases(std::vector<OpCase>& cases) {
     for (const auto& [a, b] : shapes) {
       const bool divide = std::string(op_name) == "Div";
       cases.push_back({std::string(op_name) + "_" + a.name + "_" + b.name,
-                       [op](const Inputs& in) { return op(in[0], in[1]); },
+                       [op = op](const Inputs& in) { return op(in[0], in[1]); },
                        {Any(a.rows, a.cols, seed), divide ? Positive(b.rows, b.cols, seed + 1)
                                                           : Any(b.rows, b.cols, seed + 1)}});
       seed += 2;

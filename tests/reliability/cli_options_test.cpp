@@ -293,7 +293,7 @@ TEST(TrainOptionsTable, TheSweepKeysAreItsRowsInRankOrderAndTheOthersAreRefusedW
       continue;
     }
     ASSERT_TRUE(values.contains(name)) << "give the sweep key " << name << " a value here";
-    spec[name] = {values.at(name)};
+    spec[name] = json::array({values.at(name)});  // not {x}: clang reads that as a copy
     keys.push_back(&option);
   }
   EXPECT_EQ(keys.size(), values.size());

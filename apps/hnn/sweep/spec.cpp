@@ -46,7 +46,9 @@ std::string known_keys() { return fmt::format("{}", fmt::join(spec_keys(), ", ")
 // One grid's keys, checked, in the file's order (the first key varies slowest).
 std::vector<Axis> axes_of(const ordered_json& grid) {
   std::vector<Axis> axes;
-  for (const auto& [name, values] : grid.items()) {
+  for (const auto& item : grid.items()) {
+    const std::string& name = item.key();
+    const ordered_json& values = item.value();
     const auto prefix = [&](const std::string& what) {
       return bad(fmt::format("key '{}': {}", name, what));
     };
