@@ -9,11 +9,6 @@
 namespace hnn::reliability {
 namespace {
 
-struct BadTrain {
-  std::vector<std::string> args;
-  std::string message;
-};
-
 TEST(DataTaskCli, TrainsOnASimulatedFileAndRefusesBadOptionsInOneLine) {
   const TempDir dir;
   const std::string csv = simulated_pendulum_csv(dir.path()), out = (dir / "run").string();

@@ -143,10 +143,16 @@ bool wait_until(F done, double seconds) {
   return done();
 }
 
-/// The lines of `text` (without their newlines).
+/// A bad command and its whole one error line.
 struct BadOption {
   std::vector<std::string> args;  // after `hnn`; a train run's --out is appended
   std::string message;            // the whole line after "hnn: error: "
+};
+
+/// A bad `hnn train` and how its one error line starts.
+struct BadTrain {
+  std::vector<std::string> args;  // after `hnn`
+  std::string message;            // the start of the line after "hnn: error: "
 };
 
 /// A bad command: exit 1, its one line on stderr (CLI11's own parse errors end with a pointer to

@@ -10,11 +10,6 @@
 namespace hnn::reliability {
 namespace {
 
-struct BadTrain {
-  std::vector<std::string> args;
-  std::string message;  // the start of the line after "hnn: error: "
-};
-
 TEST(RolloutCli, TrainsThroughLeapfrogAndRefusesBadSettingsInOneLine) {
   const TempDir dir;
   const std::string out = (dir / "run").string();
