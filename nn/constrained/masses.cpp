@@ -6,6 +6,7 @@
 #include <Eigen/Cholesky>
 #include <algorithm>
 #include <stdexcept>
+#include <utility>
 
 namespace hnn::nn {
 
@@ -103,17 +104,17 @@ struct Decomposition {
 };
 
 Decomposition decompose(const ConstraintSpec& spec) {
-  const std::vector<Term> all = terms(spec);
+  std::vector<Term> all = terms(spec);
   const Eigen::MatrixXd inverse =
       spec.mass.llt().solve(Eigen::MatrixXd::Identity(spec.points, spec.points));
   Decomposition out{{}, Eigen::VectorXd(Index(all.size()))};
   Eigen::VectorXd& c = out.coefficients;
   Eigen::MatrixXd sum = Eigen::MatrixXd::Zero(spec.points, spec.points);
   for (Index k = 0; k < c.size(); ++k) {
-    const Term& t = all[std::size_t(k)];
+    Term& t = all[std::size_t(k)];
     c[k] = inverse(t.at, t.at) - (t.less < 0 ? 0.0 : inverse(t.less, t.less));
     sum += c[k] * t.basis;
-    out.basis.push_back(t.basis);
+    out.basis.push_back(std::move(t.basis));
   }
   const double miss = (sum - inverse).cwiseAbs().maxCoeff();
   if (miss > 1e-9 * inverse.cwiseAbs().maxCoeff() || (c.array() <= 0).any()) {

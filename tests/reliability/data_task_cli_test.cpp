@@ -48,9 +48,7 @@ TEST(DataTaskCli, TrainsOnASimulatedFileAndRefusesBadOptionsInOneLine) {
   for (const BadTrain& bad : cases) {
     const Result r = run_hnn(bad.args, dir.path());
     const std::string what = fmt::format("{}", fmt::join(bad.args, " "));
-    EXPECT_EQ(r.code, 1) << what;
-    EXPECT_TRUE(r.err.starts_with("hnn: error: " + bad.message)) << what << "\n  got: " << r.err;
-    EXPECT_EQ(lines(r.err).size(), 1u) << what;
+    expect_one_line_error_starting(r, bad.message, what);
     EXPECT_FALSE(fs::exists(dir / "run")) << what;
   }
 }

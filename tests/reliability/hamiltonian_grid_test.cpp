@@ -115,9 +115,7 @@ TEST_F(HamiltonianGrid, RefusesABaselineAndBadSlicesInOneLine) {
     const bool baseline = message.starts_with("a baseline");
     const Result r = grid(baseline ? "baseline" : "hnn", args);
     const std::string what = fmt::format("{}", fmt::join(extra, " "));
-    EXPECT_EQ(r.code, 1) << what;
-    EXPECT_TRUE(r.err.starts_with("hnn: error: " + message)) << what << "\n  got: " << r.err;
-    EXPECT_EQ(lines(r.err).size(), 1u) << what << "\n  got: " << r.err;
+    expect_one_line_error_starting(r, message, what);
     EXPECT_FALSE(fs::exists(out)) << what;
   }
 }

@@ -187,6 +187,14 @@ inline std::vector<std::string> lines(const std::string& text) {
   return out;
 }
 
+/// A bad command: exit 1, and one line on stderr that starts with "hnn: error: " + `start`.
+inline void expect_one_line_error_starting(const Result& r, const std::string& start,
+                                           const std::string& what) {
+  EXPECT_EQ(r.code, 1) << what;
+  EXPECT_TRUE(r.err.starts_with("hnn: error: " + start)) << what << "\n  got: " << r.err;
+  EXPECT_EQ(lines(r.err).size(), 1u) << what << "\n  got: " << r.err;
+}
+
 /// The shipped real-pendulum data file.
 inline fs::path shipped_pendulum_data() {
   return fs::path(HNN_SOURCE_DIR) / "data" / "lipson" / "real_pend_h_1.txt";

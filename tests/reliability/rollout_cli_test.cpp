@@ -64,9 +64,7 @@ TEST(RolloutCli, TrainsThroughLeapfrogAndRefusesBadSettingsInOneLine) {
     args.insert(args.end(), {"--steps", "5", "--hidden", "8", "--quiet", "--out", out});
     const Result r = run_hnn(args, dir.path());
     const std::string what = fmt::format("{}", fmt::join(bad.args, " "));
-    EXPECT_EQ(r.code, 1) << what;
-    EXPECT_TRUE(r.err.starts_with("hnn: error: " + bad.message)) << what << "\n  got: " << r.err;
-    EXPECT_EQ(lines(r.err).size(), 1u) << what;
+    expect_one_line_error_starting(r, bad.message, what);
     EXPECT_FALSE(fs::exists(dir / "run")) << what;
   }
 }

@@ -42,9 +42,7 @@ void expect_refused(const fs::path& run, const fs::path& dir, const std::vector<
     args.insert(args.end(), bad.extra.begin(), bad.extra.end());
     const Result r = run_hnn(args, dir);
     const std::string what = fmt::format("{}", fmt::join(bad.extra, " "));
-    EXPECT_EQ(r.code, 1) << what;
-    EXPECT_TRUE(r.err.starts_with("hnn: error: " + bad.message)) << what << "\n  got: " << r.err;
-    EXPECT_EQ(lines(r.err).size(), 1u) << what << "\n  got: " << r.err;
+    expect_one_line_error_starting(r, bad.message, what);
     EXPECT_FALSE(fs::exists(dir / "bad.csv")) << what;
   }
 }

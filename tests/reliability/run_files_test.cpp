@@ -160,9 +160,7 @@ TEST_F(RunFiles, BadMetricsFilesAreRefused) {
       message.replace(at, 3, run.string());
     }
     const Result r = run_hnn({"evaluate", run.string()}, dir_.path());
-    EXPECT_EQ(r.code, 1) << c.name;
-    EXPECT_EQ(lines(r.err).size(), 1u) << c.name << ": " << r.err;
-    EXPECT_TRUE(r.err.starts_with("hnn: error: " + message)) << c.name << ": " << r.err;
+    expect_one_line_error_starting(r, message, c.name);
   }
 }
 

@@ -167,9 +167,7 @@ TEST(ScatteredCli, RefusalsAreOneLineAndWriteNothing) {
   for (const BadScattered& bad : cases) {
     const Result r = run_hnn(bad.args, dir.path());
     const std::string what = fmt::format("{}", fmt::join(bad.args, " "));
-    EXPECT_EQ(r.code, 1) << what;
-    EXPECT_TRUE(r.err.starts_with("hnn: error: " + bad.message)) << what << "\n  got: " << r.err;
-    EXPECT_EQ(lines(r.err).size(), 1u) << what;
+    expect_one_line_error_starting(r, bad.message, what);
     EXPECT_FALSE(fs::exists(out)) << what;
     EXPECT_FALSE(fs::exists(dir / "x.csv")) << what;
   }

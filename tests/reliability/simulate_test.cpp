@@ -182,9 +182,7 @@ TEST(Simulate, BadOptionsGetOneLineAndNoFile) {
     const std::vector<std::string> args = with(simulate_args(kPendulum, out), bad.replace);
     const Result r = run_hnn(args, dir.path());
     const std::string what = bad.replace[0] + " " + bad.replace[1];
-    EXPECT_EQ(r.code, 1) << what;
-    EXPECT_TRUE(r.err.starts_with("hnn: error: " + bad.message)) << what << "\n  got: " << r.err;
-    EXPECT_EQ(lines(r.err).size(), 1u) << what;
+    expect_one_line_error_starting(r, bad.message, what);
     EXPECT_FALSE(fs::exists(out)) << what;
   }
   const Result missing = run_hnn({"simulate", "--hamiltonian", "q^2"}, dir.path());
