@@ -150,12 +150,15 @@ int default_threads() {
 }
 
 std::mutex g_pool_mutex;
-int g_threads = default_threads();
+// Atomic: every op reads it (parts_for), from every thread of an evaluation's rollouts, and a
+// lock there was contended.
+std::atomic<int> g_threads = default_threads();
 std::shared_ptr<Pool> g_pool;
 
 std::shared_ptr<Pool> pool() {
   std::lock_guard lock(g_pool_mutex);
-  if (!g_pool || g_pool->threads() != g_threads) g_pool = std::make_shared<Pool>(g_threads);
+  const int threads = g_threads.load(std::memory_order_relaxed);
+  if (!g_pool || g_pool->threads() != threads) g_pool = std::make_shared<Pool>(threads);
   return g_pool;
 }
 
@@ -164,13 +167,10 @@ std::shared_ptr<Pool> pool() {
 void set_num_threads(int n) {
   HNN_AD_CHECK(n >= 1, "set_num_threads: need at least 1 thread, got {}", n);
   std::lock_guard lock(g_pool_mutex);
-  g_threads = n;
+  g_threads.store(n, std::memory_order_relaxed);
 }
 
-int num_threads() {
-  std::lock_guard lock(g_pool_mutex);
-  return g_threads;
-}
+int num_threads() { return g_threads.load(std::memory_order_relaxed); }
 
 void parallel_for(int parts, PartFn part) {
   HNN_AD_CHECK(parts >= 1, "parallel_for: need at least 1 part, got {}", parts);

@@ -3,12 +3,14 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <iterator>
 #include <numeric>
 #include <random>
 #include <stdexcept>
 
+#include "autodiff/parallel.h"
 #include "nn/dynamics.h"
 #include "physics/integrator.h"
 #include "physics/types.h"
@@ -66,28 +68,51 @@ Eigen::MatrixXd pick(const Eigen::MatrixXd& path, const std::vector<std::size_t>
 
 using EnergyFn = std::function<Eigen::VectorXd(const Eigen::MatrixXd&)>;
 
-// The learned rollout from x0 as the next trajectory of r: its path, energy and learned H, or a
-// failure (NaN path) with the time reached.
-void add_learned(Rollouts& r, const LearnedField& learned, const Eigen::RowVectorXd& x0,
-                 const Times& times, const RolloutConfig& config, const EnergyFn& energy) {
-  const Eigen::Index i = Eigen::Index(r.pred.size());
-  try {
-    const Eigen::MatrixXd path =
-        integrate_one(learned.field, x0, times.all, config, &r.nfev, config.max_learned_steps);
-    r.pred.push_back(pick(path, times.grid));
-    r.pred_at.push_back(pick(path, times.horizons));
-    r.failed.push_back(false);
+// One learned rollout: its path, or why it failed (an integration that gives up, or a learned
+// field that cannot be evaluated on the way: an LNN whose mass matrix turns singular).
+struct LearnedPath {
+  Eigen::MatrixXd path;
+  long nfev = 0;
+  std::string failure;  // empty: it finished
+};
+
+// The learned rollouts from every row of `starts`, appended to r in order, with the true energy
+// along each (`energy`, if given) and the model's own H. The rollouts are shared among the
+// engine's threads, one whole trajectory at a time (its field's products run on that thread
+// alone, as with one thread: the same numbers at any thread count). The energies come after,
+// on this thread: a system may be a GiNaC expression, which is not safe to share.
+void add_learned(Rollouts& r, const LearnedField& learned, const Batch& starts, const Times& times,
+                 const RolloutConfig& config, const EnergyFn& energy) {
+  if (starts.rows() == 0) return;
+  std::vector<LearnedPath> paths(std::size_t(starts.rows()));
+  std::atomic<Eigen::Index> next{0};  // trajectories are claimed in turn: their costs differ
+  const auto threads = Eigen::Index(ad::num_threads());
+  ad::parallel_for(int(std::min(threads, starts.rows())), [&](int) {
+    for (Eigen::Index i = next++; i < starts.rows(); i = next++) {
+      LearnedPath& out = paths[std::size_t(i)];
+      try {
+        out.path = integrate_one(learned.field, starts.row(i), times.all, config, &out.nfev,
+                                 config.max_learned_steps);
+      } catch (const std::exception& e) {
+        out.failure = e.what();
+      }
+    }
+  });
+  for (LearnedPath& p : paths) {
+    const Eigen::Index i = Eigen::Index(r.pred.size()), dim = starts.cols();
+    r.nfev += p.nfev;
+    r.failed.push_back(!p.failure.empty());
+    if (!p.failure.empty()) {
+      r.pred.push_back(Eigen::MatrixXd::Constant(Eigen::Index(times.grid.size()), dim, NAN));
+      r.pred_at.push_back(Eigen::MatrixXd::Constant(Eigen::Index(times.horizons.size()), dim, NAN));
+      r.failures.push_back(fmt::format("trajectory {}: {}", i, p.failure));
+      continue;
+    }
+    r.pred.push_back(pick(p.path, times.grid));
+    r.pred_at.push_back(pick(p.path, times.horizons));
     if (energy) r.pred_energy.row(i) = energy(r.pred.back()).transpose();
     if (learned.hamiltonian)
       r.learned_h.row(i) = learned.hamiltonian(Batch(r.pred.back())).transpose();
-  } catch (const std::exception& e) {
-    // An integration that gives up, or a learned field that cannot be evaluated on the way (an
-    // LNN whose mass matrix turns singular): the rollout failed there, the others go on.
-    r.pred.push_back(Eigen::MatrixXd::Constant(Eigen::Index(times.grid.size()), x0.size(), NAN));
-    r.pred_at.push_back(
-        Eigen::MatrixXd::Constant(Eigen::Index(times.horizons.size()), x0.size(), NAN));
-    r.failed.push_back(true);
-    r.failures.push_back(fmt::format("trajectory {}: {}", i, e.what()));
   }
 }
 
@@ -138,10 +163,10 @@ Rollouts make_rollouts(const physics::System& truth, const LearnedField& learned
       r.floor.push_back(pick(moved, times.grid));
       r.floor_at.push_back(pick(moved, times.horizons));
     }
-    add_learned(r, learned, x0.row(i), times, config, [&](const Eigen::MatrixXd& states) {
-      return Eigen::VectorXd(truth.energy_batch(Batch(states)));
-    });
   }
+  add_learned(r, learned, x0, times, config, [&](const Eigen::MatrixXd& states) {
+    return Eigen::VectorXd(truth.energy_batch(Batch(states)));
+  });
   return r;
 }
 
@@ -160,14 +185,16 @@ Rollouts follow_measured(const std::vector<Eigen::MatrixXd>& measured, const Lea
   r.true_energy.setConstant(n, m, NAN);
   r.pred_energy.setConstant(n, m, NAN);
   if (learned.hamiltonian) r.learned_h.setConstant(n, m, NAN);
+  Batch starts(n, measured.empty() ? 0 : measured.front().cols());
   for (const Eigen::MatrixXd& path : measured) {
     HNN_TASKS_CHECK(path.rows() == m && path.row(0).allFinite(),
                     "follow_measured: a path of {} rows for {} times, or without its start",
                     path.rows(), m);
+    starts.row(Eigen::Index(r.truth.size())) = path.row(0);
     r.truth.push_back(path);
     r.truth_at.push_back(pick(path, times.horizons));
-    add_learned(r, learned, path.row(0), times, config, nullptr);
   }
+  add_learned(r, learned, starts, times, config, nullptr);
   return r;
 }
 
