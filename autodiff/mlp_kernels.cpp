@@ -111,19 +111,34 @@ void reduce_parameters(const MlpLayers<T>& l, std::vector<PartSpace<T>>& space, 
   }
 }
 
+// Whether the sweep wants any weight or bias gradient. A Jacobian with respect to the input
+// alone (the LNN's Hessian blocks, evaluated on every rollout state) wants none: its kernels then
+// skip the partial parameter gradients, GEMMs the size of the weights (half an LNN evaluation's
+// time went to them and to zeroing their outputs).
+template <typename T>
+bool wants_parameters(const MlpLayers<T>& l, const GradSink<T>& s) {
+  for (int k = 1; k <= l.count(); ++k) {
+    const int bi = l.bias_input(k);
+    if (s.wants(l.weight_input(k)) || (bi >= 0 && s.wants(bi))) return true;
+  }
+  return false;
+}
+
 // ---- tanh_mlp -----------------------------------------------------------------------------------
 
 // Backpropagation over rows r: partial parameter gradients into w, dx rows into dx (if wanted).
 template <typename T>
 void backprop_rows(const MlpLayers<T>& l, const Node<T>& n, const Var<T>& g, PartSpace<T>& w,
-                   RowBlock r, Matrix<T>* dx) {
+                   RowBlock r, Matrix<T>* dx, bool params) {
   Matrix<T>* delta = &w.grad[std::size_t(l.count())];
   *delta = g.value().middleRows(r.begin, r.size());
   for (int k = l.count(); k >= 1; --k) {
     const auto prev = hidden_block(l, n.buffers, k - 1, r);
-    w.dw[std::size_t(k)].resize(prev.cols(), delta->cols());
-    gemm(prev, true, *delta, false, w.dw[std::size_t(k)]);
-    if (l.bias_input(k) >= 0) {
+    if (params) {
+      w.dw[std::size_t(k)].resize(prev.cols(), delta->cols());
+      gemm(prev, true, *delta, false, w.dw[std::size_t(k)]);
+    }
+    if (params && l.bias_input(k) >= 0) {
       w.db[std::size_t(k)].resize(1, delta->cols());
       column_sums(*delta, w.db[std::size_t(k)]);
     }
@@ -151,7 +166,7 @@ auto rows_of(const Node<T>& n, std::size_t i, RowBlock r) {
 // of dW_L (each dbar_k becomes abar_k in place). Output 0 sets the sums, later outputs add.
 template <typename T>
 void up_the_gradient_chain(const MlpLayers<T>& l, const Node<T>& n, const Var<T>& g, int j,
-                           PartSpace<T>& w, RowBlock r) {
+                           PartSpace<T>& w, RowBlock r, bool params) {
   const GradientBuffers at{l.count(), l.outputs()};
   const Index in = l.x().cols();
   const T beta = j == 0 ? T(0) : T(1);
@@ -162,8 +177,10 @@ void up_the_gradient_chain(const MlpLayers<T>& l, const Node<T>& n, const Var<T>
     Matrix<T>* dbar = &w.grad[std::size_t(k)];
     dbar->resize(abar->rows(), l.w(k).cols());
     gemm(*abar, false, l.w(k), false, *dbar);
-    w.dw[std::size_t(k)].resize(abar->cols(), l.w(k).cols());  // kept by later outputs
-    gemm(*abar, true, rows_of(n, at.d(k, j), r), false, w.dw[std::size_t(k)], beta);
+    if (params) {
+      w.dw[std::size_t(k)].resize(abar->cols(), l.w(k).cols());  // kept by later outputs
+      gemm(*abar, true, rows_of(n, at.d(k, j), r), false, w.dw[std::size_t(k)], beta);
+    }
     Matrix<T>& hbar = w.hbar[std::size_t(k)];
     hbar.resize(dbar->rows(), dbar->cols());
     const auto term = T(-2) * hk.array() * rows_of(n, at.a(k, j), r).array() * dbar->array();
@@ -175,6 +192,7 @@ void up_the_gradient_chain(const MlpLayers<T>& l, const Node<T>& n, const Var<T>
     dbar->array() *= T(1) - hk.array().square();
     abar = dbar;
   }
+  if (!params) return;
   w.dw[std::size_t(l.count())].resize(abar->cols(), at.columns);
   // Summed into a contiguous row first: added straight into the column (a stride of m
   // elements), the sum did not vectorise and cost as much as a GEMM's packing.
@@ -187,13 +205,15 @@ void up_the_gradient_chain(const MlpLayers<T>& l, const Node<T>& n, const Var<T>
 // and dx rows into dx (if wanted).
 template <typename T>
 void down_the_forward_chain(const MlpLayers<T>& l, const Node<T>& n, PartSpace<T>& w, RowBlock r,
-                            Matrix<T>* dx) {
+                            Matrix<T>* dx, bool params) {
   const GradientBuffers at{l.count(), l.outputs()};
   Matrix<T>* hb = &w.hbar[std::size_t(l.count() - 1)];
   for (int k = l.count() - 1; k >= 1; --k) {
     hb->array() *= T(1) - rows_of(n, at.h(k), r).array().square();
-    gemm(hidden_block(l, n.buffers, k - 1, r), true, *hb, false, w.dw[std::size_t(k)], T(1));
-    if (l.bias_input(k) >= 0) {
+    if (params) {
+      gemm(hidden_block(l, n.buffers, k - 1, r), true, *hb, false, w.dw[std::size_t(k)], T(1));
+    }
+    if (params && l.bias_input(k) >= 0) {
       w.db[std::size_t(k)].resize(1, hb->cols());
       column_sums(*hb, w.db[std::size_t(k)]);
     }
@@ -278,9 +298,10 @@ void tanh_mlp_backward_kernel(const Node<T>& n, const Var<T>& g, GradSink<T>& s)
   std::vector<PartSpace<T>>& space = workspace<T>(parts, l.count());
   Node<T>* dx_node = s.wants(0) ? &value_node<T>("tanh_mlp_grad") : nullptr;
   if (dx_node) dx_node->value.resize(rows, l.x().cols());
+  const bool params = wants_parameters(l, s);
   parallel_for(parts, [&](int p) {
     backprop_rows(l, n, g, space[std::size_t(p)], row_block(rows, parts, p),
-                  dx_node ? &dx_node->value : nullptr);
+                  dx_node ? &dx_node->value : nullptr, params);
   });
   if (dx_node) s.add(0, Var<T>::of(*dx_node));
   reduce_parameters(l, space, parts, s, "tanh_mlp_grad");
@@ -296,11 +317,12 @@ void input_gradient_backward_kernel(const Node<T>& n, const Var<T>& g, GradSink<
   const bool wants_dx = s.wants(0) && l.count() > 1;
   Node<T>* dx_node = wants_dx ? &value_node<T>("tanh_mlp_input_gradient_grad") : nullptr;
   if (dx_node) dx_node->value.resize(rows, l.x().cols());
+  const bool params = wants_parameters(l, s);
   parallel_for(parts, [&](int p) {
     const RowBlock r = row_block(rows, parts, p);
     PartSpace<T>& w = space[std::size_t(p)];
-    for (int j = 0; j < l.outputs(); ++j) up_the_gradient_chain(l, n, g, j, w, r);
-    down_the_forward_chain(l, n, w, r, dx_node ? &dx_node->value : nullptr);
+    for (int j = 0; j < l.outputs(); ++j) up_the_gradient_chain(l, n, g, j, w, r, params);
+    down_the_forward_chain(l, n, w, r, dx_node ? &dx_node->value : nullptr, params);
   });
   if (dx_node) s.add(0, Var<T>::of(*dx_node));
   reduce_parameters(l, space, parts, s, "tanh_mlp_input_gradient_grad");
