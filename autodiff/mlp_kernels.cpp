@@ -137,10 +137,10 @@ void backprop_rows(const MlpLayers<T>& l, const Node<T>& n, const Var<T>& g, Par
     if (params) {
       w.dw[std::size_t(k)].resize(prev.cols(), delta->cols());
       gemm(prev, true, *delta, false, w.dw[std::size_t(k)]);
-    }
-    if (params && l.bias_input(k) >= 0) {
-      w.db[std::size_t(k)].resize(1, delta->cols());
-      column_sums(*delta, w.db[std::size_t(k)]);
+      if (l.bias_input(k) >= 0) {
+        w.db[std::size_t(k)].resize(1, delta->cols());
+        column_sums(*delta, w.db[std::size_t(k)]);
+      }
     }
     if (k > 1) {
       Matrix<T>* next = &w.grad[std::size_t(k - 1)];
@@ -212,10 +212,10 @@ void down_the_forward_chain(const MlpLayers<T>& l, const Node<T>& n, PartSpace<T
     hb->array() *= T(1) - rows_of(n, at.h(k), r).array().square();
     if (params) {
       gemm(hidden_block(l, n.buffers, k - 1, r), true, *hb, false, w.dw[std::size_t(k)], T(1));
-    }
-    if (params && l.bias_input(k) >= 0) {
-      w.db[std::size_t(k)].resize(1, hb->cols());
-      column_sums(*hb, w.db[std::size_t(k)]);
+      if (l.bias_input(k) >= 0) {
+        w.db[std::size_t(k)].resize(1, hb->cols());
+        column_sums(*hb, w.db[std::size_t(k)]);
+      }
     }
     if (k > 1) {
       gemm(*hb, false, l.w(k), true, w.hbar[std::size_t(k - 1)], T(1));

@@ -24,11 +24,12 @@ thread_local bool g_inside_part = false;
 // scheduler has not woken yet (a shared, loaded machine) therefore costs nothing: waiting for
 // every worker to answer every job stalled each op for a time slice there, making two threads
 // several times slower than one. Part i computes block i whoever runs it, so results never
-// depend on who claimed what. One job at a time: a caller that finds the pool busy runs its
-// parts itself.
+// depend on who claimed what. A job may have more parts than the pool has threads (an
+// evaluation's rollouts, one part each): whoever finishes a part claims the next. One job at a
+// time: a caller that finds the pool busy runs its parts itself.
 class Pool {
  public:
-  explicit Pool(int threads) : errors_(std::size_t(threads)) {
+  explicit Pool(int threads) : errors_(std::size_t(threads)) {  // a step's jobs: no allocation
     for (int i = 1; i < threads; ++i) workers_.emplace_back([this] { work(); });
   }
   ~Pool() {
@@ -41,9 +42,10 @@ class Pool {
 
   void run(int parts, PartFn part) {
     std::unique_lock lock(busy_, std::try_to_lock);
-    if (!lock.owns_lock() || parts > threads()) return serial(parts, part);
+    if (!lock.owns_lock() || std::uint64_t(parts) > kField) return serial(parts, part);
     job_ = &part;
-    std::fill(errors_.begin(), errors_.end(), nullptr);
+    if (errors_.size() < std::size_t(parts)) errors_.resize(std::size_t(parts));
+    std::fill_n(errors_.begin(), parts, nullptr);
     done_.store(0, std::memory_order_relaxed);
     generation_ += kGeneration;
     // Publishes the job (release: job_ and the reset counters are visible to whoever claims).
@@ -54,8 +56,8 @@ class Pool {
          d = done_.load(std::memory_order_acquire)) {
       done_.wait(d);
     }
-    for (const std::exception_ptr& e : errors_) {
-      if (e) std::rethrow_exception(e);
+    for (int i = 0; i < parts; ++i) {
+      if (errors_[std::size_t(i)]) std::rethrow_exception(errors_[std::size_t(i)]);
     }
   }
 

@@ -3,7 +3,6 @@
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <iterator>
 #include <numeric>
@@ -85,17 +84,14 @@ void add_learned(Rollouts& r, const LearnedField& learned, const Batch& starts, 
                  const RolloutConfig& config, const EnergyFn& energy) {
   if (starts.rows() == 0) return;
   std::vector<LearnedPath> paths(std::size_t(starts.rows()));
-  std::atomic<Eigen::Index> next{0};  // trajectories are claimed in turn: their costs differ
-  const auto threads = Eigen::Index(ad::num_threads());
-  ad::parallel_for(int(std::min(threads, starts.rows())), [&](int) {
-    for (Eigen::Index i = next++; i < starts.rows(); i = next++) {
-      LearnedPath& out = paths[std::size_t(i)];
-      try {
-        out.path = integrate_one(learned.field, starts.row(i), times.all, config, &out.nfev,
-                                 config.max_learned_steps);
-      } catch (const std::exception& e) {
-        out.failure = e.what();
-      }
+  // One part per trajectory: the threads claim them in turn, as their costs differ.
+  ad::parallel_for(int(starts.rows()), [&](int i) {
+    LearnedPath& out = paths[std::size_t(i)];
+    try {
+      out.path = integrate_one(learned.field, starts.row(i), times.all, config, &out.nfev,
+                               config.max_learned_steps);
+    } catch (const std::exception& e) {
+      out.failure = e.what();
     }
   });
   for (LearnedPath& p : paths) {

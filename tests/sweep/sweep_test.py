@@ -4,8 +4,9 @@ and HNN_SOURCE_DIR in the environment:  /usr/bin/python3 tests/sweep/sweep_test.
 
 Cluster starts a real `dask scheduler` and two `dask worker`s on 127.0.0.1, kills one of them in
 the middle of a run, and checks that every run finishes once, the killed one and one other with
-the metrics of the same runs trained alone by `hnn train`. The others: bad specs, the lock, --emit slurm, a run's own
-failure on a local cluster, and the shipped specs against the runs they replace."""
+the metrics of the same runs trained alone by `hnn train`. The others: bad specs, the lock,
+--emit slurm, a run's own failure on a local cluster, and the shipped specs against the runs
+they replace."""
 
 import csv
 import fcntl
