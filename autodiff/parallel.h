@@ -31,9 +31,10 @@ class PartFn {
 /// Calls part(i) for i in [0, parts) concurrently and returns when all have finished: the caller
 /// and the workers claim parts as they get to them, so a worker the scheduler has not woken yet
 /// delays nothing (Note [Claimed parts] in parallel.cpp). The first exception thrown by a part
-/// (lowest i) is rethrown here. Nested calls, and calls
-/// while another thread's job holds the workers, run the same parts serially: the split (and so
-/// every result, bit for bit) depends only on `parts`.
+/// (lowest i) is rethrown here. `parts` may exceed the threads: whoever finishes a part claims the
+/// next. Nested calls, calls while another thread's job holds the workers, and jobs of more than
+/// 65,535 parts run the same parts serially: the split (and so every result, bit for bit)
+/// depends only on `parts`.
 void parallel_for(int parts, PartFn part);
 
 /// Row block i of `parts` equal blocks of `rows`: [begin, end).
