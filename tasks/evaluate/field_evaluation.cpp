@@ -6,6 +6,8 @@
 #include <cmath>
 
 #include "autodiff/tape.h"
+#include "nn/constrained/constrained_model.h"
+#include "nn/constrained/masses.h"
 #include "nn/hnn.h"
 #include "tasks/evaluate/energy_errors.h"
 #include "tasks/evaluate/hamiltonian_error.h"
@@ -38,6 +40,24 @@ double dissipation_share(const nn::DynamicsModel<double>& model, const Batch& x,
   }
   const double d = conservative.squaredNorm();
   return d / (solenoidal.squaredNorm() + d);
+}
+
+json learned_mass_metrics(const nn::DynamicsModel<double>& model) {
+  const auto* constrained = dynamic_cast<const nn::ConstrainedModel<double>*>(&model);
+  if (constrained == nullptr || !model.config().constraints.learned_masses) return json::object();
+  // Coefficients c_k = 1 / (a mass or a moment); reported as the masses and moments themselves.
+  const Eigen::VectorXd learned = constrained->inverse_mass_coefficients().row(0).cwiseInverse();
+  const Eigen::VectorXd truth =
+      nn::inverse_mass_coefficients(model.config().constraints).cwiseInverse();
+  const Eigen::ArrayXd ratios = (learned / learned[0]).array() / (truth / truth[0]).array();
+  return {{"masses_learned", std::vector<double>(learned.begin(), learned.end())},
+          {"masses_true", std::vector<double>(truth.begin(), truth.end())},
+          {"masses_ratio_error", (ratios - 1).abs().maxCoeff()},
+          {"masses_note",
+           "per body, its mass, then a rigid body's moments about its axes (nn/constrained/"
+           "masses.h); the motion fixes them up to one factor shared with the potential, so "
+           "masses_ratio_error compares each relative to the first: max |(learned_k / learned_0) "
+           "/ (true_k / true_0) - 1|"}};
 }
 
 json rollout_metrics(const Rollouts& r, double threshold) {
@@ -113,6 +133,7 @@ json point_metrics(const nn::DynamicsModel<double>& model, const Dataset& data) 
             {"n_train", data.train_x.rows()},   {"n_test", data.test_x.rows()}};
   if (model.config().field == nn::FieldType::kBoth)
     m["dissipation_share"] = number(dissipation_share(model, data.test_x));
+  m.update(learned_mass_metrics(model));
   m["train_r2"] = number(r_squared(train.mean, data.train_dxdt));
   m["test_r2"] = number(r_squared(test.mean, data.test_dxdt));
   return m;

@@ -5,9 +5,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "nn/constrained/constrained_model.h"
+#include "nn/constrained/masses.h"
 #include "nn/mass_hnn.h"
 #include "physics/constrained/chain_angles.h"
 #include "physics/constrained/metric.h"
@@ -215,7 +217,21 @@ TEST(ConstrainedTask, TheConstrainedModelsLearnTheirMassesWhenAsked) {
     EXPECT_GT(c.minCoeff(), 0.5) << task;
     EXPECT_LT(c.maxCoeff(), 2.0) << task;
     EXPECT_NE(model->describe().find("learned masses"), std::string::npos) << task;
+    // metrics.json gives them as masses and moments, beside the system's own.
+    const auto learned = m.at("masses_learned").get<std::vector<double>>();
+    const Eigen::VectorXd truth = nn::inverse_mass_coefficients(model->config().constraints);
+    ASSERT_EQ(learned.size(), std::size_t(count)) << task;
+    ASSERT_EQ(m.at("masses_true").size(), std::size_t(count)) << task;
+    double worst = 0;
+    for (int k = 0; k < count; ++k) {
+      EXPECT_NEAR(learned[std::size_t(k)] * c(0, k), 1.0, 1e-12) << task;
+      EXPECT_NEAR(m["masses_true"][std::size_t(k)].get<double>() * truth[k], 1.0, 1e-12) << task;
+      worst = std::max(worst, std::abs(c(0, 0) / c(0, k) * truth[k] / truth[0] - 1));
+    }
+    EXPECT_NEAR(m.at("masses_ratio_error").get<double>(), worst, 1e-12) << task;
   }
+  const nlohmann::json known = run_training(tiny("chnn", dir / "known"));
+  EXPECT_FALSE(known.contains("masses_learned"));
   RunOptions hnn = tiny("hnn", dir / "h");
   hnn.task_settings["masses"] = "learned";
   try {

@@ -168,6 +168,22 @@ std::string constrained_line(const json& m) {
                             number_at(m, "cartesian_error_rollouts").value_or(NAN));
 }
 
+// Learned masses (--masses learned) beside the system's, compared as ratios (the motion fixes
+// them up to a factor shared with the potential).
+std::string masses_line(const json& m) {
+  const auto ratio = number_at(m, "masses_ratio_error");
+  if (!ratio) return "";
+  const auto list = [&](const char* key) {
+    std::string out;
+    for (const json& v : m.at(key))
+      out += fmt::format("{}{:.4g}", out.empty() ? "" : ", ", v.get<double>());
+    return out;
+  };
+  return fmt::format(
+      "  masses     learned {} (true {}); ratios to the first off by {:.2g} at most\n",
+      list("masses_learned"), list("masses_true"), *ratio);
+}
+
 std::string timing_line(const json& m) {
   constexpr std::pair<const char*, const char*> kTimes[] = {
       {"train_seconds", "training"}, {"data_seconds", "data"}, {"eval_seconds", "evaluation"}};
@@ -185,8 +201,8 @@ std::string timing_line(const json& m) {
 
 std::string metrics_summary(const json& m) {
   return heading_line(m) + "\n" + loss_lines(m) + prediction_line(m) + constrained_line(m) +
-         skipped_rollouts_line(m) + hamiltonian_line(m) + energy_lines(m) + fit_line(m) +
-         timing_line(m);
+         masses_line(m) + skipped_rollouts_line(m) + hamiltonian_line(m) + energy_lines(m) +
+         fit_line(m) + timing_line(m);
 }
 
 void print_warnings(const json& metrics) {
