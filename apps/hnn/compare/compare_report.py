@@ -8,6 +8,7 @@ metric appears here once its runs write it and the peers file names it, without 
 import json
 import math
 import os
+import textwrap
 
 import sweep_report
 
@@ -285,6 +286,16 @@ def markdown(doc):
     return "\n".join(md) + "\n"
 
 
+def at_least_a_decade(ax):
+    """Widens each log axis of ax to span at least one decade around its data: over less,
+    matplotlib labels every minor tick and the labels run into each other."""
+    for get, put in ((ax.get_xlim, ax.set_xlim), (ax.get_ylim, ax.set_ylim)):
+        lo, hi = get()
+        if 0 < lo and hi < 10 * lo:
+            middle = math.sqrt(lo * hi)
+            put(middle / math.sqrt(10), middle * math.sqrt(10))
+
+
 def draw(doc, path):
     """One panel per task (its headline metric differs from task to task): each row's headline
     against its training time, log-log, one colour per model family and loss."""
@@ -294,7 +305,11 @@ def draw(doc, path):
     tasks = sweep_report.ordered(r["task"] for r in doc["rows"])
     cols = min(3, len(tasks))
     rows_n = (len(tasks) + cols - 1) // cols
-    fig, axes = plt.subplots(rows_n, cols, figsize=(4.2 * cols, 3.4 * rows_n), squeeze=False)
+    # The title wraps to the figure's width (a panel is 4.2 inches wide) and adds to its height.
+    heading = textwrap.wrap("accuracy against training time (mean ± standard error over seeds; "
+                            "dashed: the peer's published number for that family)", 55 * cols)
+    height = 3.4 * rows_n + 0.2 * len(heading)
+    fig, axes = plt.subplots(rows_n, cols, figsize=(4.2 * cols, height), squeeze=False)
     colours = {}
     for ax, task in zip(axes.flat, tasks):
         headline = title = None
@@ -319,6 +334,7 @@ def draw(doc, path):
         if ax.has_data():
             ax.set_xscale("log")
             ax.set_yscale("log")
+            at_least_a_decade(ax)
         ax.set_title(title, fontsize=9)
         ax.set_xlabel("train_seconds (s)", fontsize=8)
         ax.set_ylabel(headline or "", fontsize=8)
@@ -328,11 +344,11 @@ def draw(doc, path):
     from matplotlib.lines import Line2D
     handles = [Line2D([], [], color=c, marker="o", linestyle="none", label=f)
                for f, c in colours.items()]
-    fig.legend(handles=handles, fontsize=8, loc="lower center", ncol=max(1, len(handles)),
-               frameon=False)
-    fig.suptitle("accuracy against training time (mean ± standard error over seeds; dashed: the "
-                 "peer's published number for that family)", fontsize=10)
-    fig.tight_layout(rect=(0, 0.06, 1, 0.96))
+    legend_cols = max(1, min(len(handles), 2 * cols))
+    legend_rows = -(-len(handles) // legend_cols)
+    fig.legend(handles=handles, fontsize=8, loc="lower center", ncol=legend_cols, frameon=False)
+    fig.suptitle("\n".join(heading), fontsize=10)
+    fig.tight_layout(rect=(0, (0.1 + 0.2 * legend_rows) / height, 1, 1))
     fig.savefig(path, dpi=120)
     plt.close(fig)
 
