@@ -8,7 +8,6 @@ metric appears here once its runs write it and the peers file names it, without 
 import json
 import math
 import os
-import textwrap
 
 import sweep_report
 
@@ -286,16 +285,6 @@ def markdown(doc):
     return "\n".join(md) + "\n"
 
 
-def at_least_a_decade(ax):
-    """Widens each log axis of ax to span at least one decade around its data: over less,
-    matplotlib labels every minor tick and the labels run into each other."""
-    for get, put in ((ax.get_xlim, ax.set_xlim), (ax.get_ylim, ax.set_ylim)):
-        lo, hi = get()
-        if 0 < lo and hi < 10 * lo:
-            middle = math.sqrt(lo * hi)
-            put(middle / math.sqrt(10), middle * math.sqrt(10))
-
-
 def draw(doc, path):
     """One panel per task (its headline metric differs from task to task): each row's headline
     against its training time, log-log, one colour per model family and loss."""
@@ -305,9 +294,10 @@ def draw(doc, path):
     tasks = sweep_report.ordered(r["task"] for r in doc["rows"])
     cols = min(3, len(tasks))
     rows_n = (len(tasks) + cols - 1) // cols
-    # The title wraps to the figure's width (a panel is 4.2 inches wide) and adds to its height.
-    heading = textwrap.wrap("accuracy against training time (mean ± standard error over seeds; "
-                            "dashed: the peer's published number for that family)", 55 * cols)
+    # The title wraps to the figure's width and adds to its height.
+    heading = sweep_report.title_lines("accuracy against training time (mean ± standard error "
+                                       "over seeds; dashed: the peer's published number for that "
+                                       "family)", 4.2 * cols)
     height = 3.4 * rows_n + 0.2 * len(heading)
     fig, axes = plt.subplots(rows_n, cols, figsize=(4.2 * cols, height), squeeze=False)
     colours = {}
@@ -334,7 +324,7 @@ def draw(doc, path):
         if ax.has_data():
             ax.set_xscale("log")
             ax.set_yscale("log")
-            at_least_a_decade(ax)
+            sweep_report.readable_log_ticks(ax)
         ax.set_title(title, fontsize=9)
         ax.set_xlabel("train_seconds (s)", fontsize=8)
         ax.set_ylabel(headline or "", fontsize=8)

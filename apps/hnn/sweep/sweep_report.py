@@ -7,6 +7,7 @@ import json
 import math
 import os
 import shlex
+import textwrap
 import time
 
 
@@ -169,7 +170,9 @@ def draw_chart(plan, rows, chart, path):
     numeric = "x_metric" in chart or all(isinstance(r["values"].get(x), (int, float))
                                          for r in rows)
     facets = ordered(cell(r["values"].get(facet)) for r in done) if facet else [None]
-    fig, axes = plt.subplots(1, max(1, len(facets)), figsize=(4.6 * max(1, len(facets)), 3.6),
+    width = 4.6 * max(1, len(facets))
+    title = title_lines(chart["title"], width) if chart.get("title") else []
+    fig, axes = plt.subplots(1, max(1, len(facets)), figsize=(width, 3.6 + 0.2 * len(title)),
                              squeeze=False)
     for ax, fv in zip(axes[0], facets):
         mine = [r for r in done if fv is None or cell(r["values"].get(facet)) == fv]
@@ -193,17 +196,37 @@ def draw_chart(plan, rows, chart, path):
             ax.set_xscale("log")
         if chart.get("log_y"):
             ax.set_yscale("log")
+        readable_log_ticks(ax)
         ax.set_xlabel(x)
         ax.set_ylabel(y)
         if fv is not None:
             ax.set_title(f"{facet} {fv}")
         if series:
             ax.legend(title=series, fontsize=8)
-    if chart.get("title"):
-        fig.suptitle(chart["title"])
+    if title:
+        fig.suptitle("\n".join(title), fontsize=10)
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)
+
+
+def readable_log_ticks(ax):
+    """On a log axis of ax spanning under a decade, where matplotlib labels every minor tick and
+    the labels run into each other: four or so evenly spaced ticks, labelled in three digits."""
+    from matplotlib.ticker import FuncFormatter, MaxNLocator, NullFormatter
+    for axis, get in ((ax.xaxis, ax.get_xlim), (ax.yaxis, ax.get_ylim)):
+        lo, hi = get()
+        if axis.get_scale() != "log" or not 0 < lo < hi or hi >= 10 * lo:
+            continue
+        axis.set_major_locator(MaxNLocator(nbins=4))
+        axis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:.3g}"))
+        axis.set_minor_formatter(NullFormatter())
+
+
+def title_lines(text, width_inches):
+    """text wrapped to a figure width_inches wide, as lines, for a title at font size 10 (about 13
+    characters an inch): a title wider than its figure is cut off at both ends."""
+    return textwrap.wrap(text, max(20, int(13 * width_inches)))
 
 
 def write_charts(plan, rows):
