@@ -4,8 +4,11 @@
 #include <fmt/ranges.h>
 
 #include <Eigen/Cholesky>
+#include <Eigen/SVD>
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
+#include <unsupported/Eigen/KroneckerProduct>
 #include <utility>
 
 namespace hnn::nn {
@@ -134,6 +137,69 @@ std::vector<Eigen::MatrixXd> inverse_mass_basis(const ConstraintSpec& spec) {
 
 Eigen::VectorXd inverse_mass_coefficients(const ConstraintSpec& spec) {
   return decompose(spec).coefficients;
+}
+
+namespace {
+
+// dPhi/dx of the position constraints at x (1 x N d): a link's or an anchor's row e^T at its
+// points (|e|^2 / 2 = l^2 / 2, e = x_i - x_j or x_i - a), a pin's d rows its weights per axis.
+Eigen::MatrixXd constraint_jacobian(const ConstraintSpec& spec, const Eigen::RowVectorXd& x) {
+  const Index d = spec.dim;
+  Eigen::MatrixXd g = Eigen::MatrixXd::Zero(spec.constraints(), spec.positions());
+  Index row = 0;
+  for (const Link& l : spec.links) {
+    const Eigen::RowVectorXd e = x.segment(l.i * d, d) - x.segment(l.j * d, d);
+    g.block(row, l.i * d, 1, d) = e;
+    g.block(row++, l.j * d, 1, d) = -e;
+  }
+  for (const Anchor& a : spec.anchors) {
+    g.block(row++, a.i * d, 1, d) =
+        x.segment(a.i * d, d) - Eigen::Map<const Eigen::RowVectorXd>(a.point.data(), d);
+  }
+  for (const Pin& p : spec.pins) {
+    for (Index k = 0; k < d; ++k, ++row)
+      for (Index j = 0; j < spec.points; ++j) g(row, j * d + k) = p.weights[std::size_t(j)];
+  }
+  return g;
+}
+
+// M (x) I_d from inverse-mass coefficients c.
+Eigen::MatrixXd full_mass(const std::vector<Eigen::MatrixXd>& basis, const Eigen::VectorXd& c,
+                          Index d) {
+  Eigen::MatrixXd inverse = Eigen::MatrixXd::Zero(basis.front().rows(), basis.front().cols());
+  for (std::size_t k = 0; k < basis.size(); ++k) inverse += c[Index(k)] * basis[k];
+  const Eigen::MatrixXd m =
+      inverse.llt().solve(Eigen::MatrixXd::Identity(inverse.rows(), inverse.cols()));
+  return Eigen::kroneckerProduct(m, Eigen::MatrixXd::Identity(d, d));
+}
+
+}  // namespace
+
+double tangent_mass_error(const ConstraintSpec& spec, const Eigen::VectorXd& c,
+                          const Eigen::MatrixXd& positions) {
+  const std::vector<Eigen::MatrixXd> basis = inverse_mass_basis(spec);
+  if (c.size() != Index(basis.size()))
+    fail(fmt::format("{} coefficients for {} learned masses", c.size(), basis.size()));
+  const Eigen::MatrixXd learned = full_mass(basis, c, spec.dim),
+                        truth = full_mass(basis, inverse_mass_coefficients(spec), spec.dim);
+  std::vector<Eigen::MatrixXd> l, t;  // reduced mass matrices at each row
+  double cross = 0, square = 0;
+  for (Index r = 0; r < positions.rows(); ++r) {
+    const Eigen::JacobiSVD<Eigen::MatrixXd> svd(constraint_jacobian(spec, positions.row(r)),
+                                                Eigen::ComputeFullV);
+    const Eigen::MatrixXd tangent = svd.matrixV().rightCols(spec.positions() - svd.rank());
+    l.push_back(tangent.transpose() * learned * tangent);
+    t.push_back(tangent.transpose() * truth * tangent);
+    cross += l.back().cwiseProduct(t.back()).sum();
+    square += l.back().squaredNorm();
+  }
+  const double scale = cross / square;
+  double off = 0, size = 0;
+  for (std::size_t r = 0; r < l.size(); ++r) {
+    off += (scale * l[r] - t[r]).squaredNorm();
+    size += t[r].squaredNorm();
+  }
+  return std::sqrt(off / size);
 }
 
 }  // namespace hnn::nn

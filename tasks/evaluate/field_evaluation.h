@@ -33,10 +33,11 @@ double dissipation_share(const nn::DynamicsModel<double>& model, const Batch& x,
                          const std::function<Batch(const Batch&)>& to_data_units = {});
 
 /// For a constrained model that learns its masses (--masses learned): masses_learned and
-/// masses_true (per body its mass, then a rigid body's moments), masses_ratio_error (the largest
-/// relative error of learned_k / learned_0 against true_k / true_0: the motion fixes the masses
-/// only up to a factor shared with the potential) and masses_note. Empty for any other model.
-nlohmann::json learned_mass_metrics(const nn::DynamicsModel<double>& model);
+/// masses_true (per body its mass, then a rigid body's moments), masses_tangent_error
+/// (nn::tangent_mass_error at up to 100 rows of the states x: what of the masses moves the
+/// system, up to the factor it shares with the potential) and masses_note. Empty for any other
+/// model.
+nlohmann::json learned_mass_metrics(const nn::DynamicsModel<double>& model, const Batch& x);
 
 /// The metrics of rollouts, each with its standard error and count (over the learned rollouts
 /// that did not fail): energy MSE and its relative form (energy_relative_mse, energy_errors.h;

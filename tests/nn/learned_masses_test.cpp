@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
 #include <cmath>
 #include <stdexcept>
 
@@ -143,4 +144,36 @@ TEST(LearnedMasses, DrawnNearOneCastAndDescribed) {
   const nn::ConstrainedModel<float> single = model.cast<float>();
   EXPECT_TRUE(single.inverse_mass_coefficients().cast<double>().isApprox(c, 1e-6));
   EXPECT_NE(model.describe().find("learned masses"), std::string::npos) << model.describe();
+}
+
+// tangent_mass_error compares masses only where the motion can tell them apart: on the tangent
+// space of the constraints, up to one scale. A body pinned at its centre moves alike whatever its
+// mass (its inertia about the pin is its moments' alone); a chain's masses all count.
+TEST(LearnedMasses, TheTangentMassErrorSeesOnlyWhatMovesTheSystem) {
+  const nn::ConstraintSpec chain =
+      chain_spec({1.0, 0.8, 1.2}, 2, Eigen::Vector3d(0.7, 1.3, 1.1).asDiagonal(), {0.1, 0});
+  const MatrixD chain_x = nn::testing::chain_states(chain, 6, 46).leftCols(6);
+  const Eigen::VectorXd c = nn::inverse_mass_coefficients(chain);
+  EXPECT_LT(nn::tangent_mass_error(chain, c, chain_x), 1e-12);
+  EXPECT_LT(nn::tangent_mass_error(chain, 3.0 * c, chain_x), 1e-12);
+  Eigen::VectorXd heavier = c;
+  heavier[1] *= 1.5;
+  EXPECT_GT(nn::tangent_mass_error(chain, heavier, chain_x), 0.01);
+
+  const nn::ConstraintSpec body = rigid_body();
+  MatrixD body_x(5, 12);  // rotations of the rest shape: centre at the pin, axis points on R e_j
+  std::mt19937_64 rng(47);
+  for (Eigen::Index r = 0; r < body_x.rows(); ++r) {
+    const Eigen::Vector3d axis = nn::random_normal<double>(3, 1, rng).col(0).normalized();
+    const Eigen::Matrix3d rotation = Eigen::AngleAxisd(1.0 + double(r), axis).toRotationMatrix();
+    body_x.row(r) << 0, 0, 0, rotation.col(0).transpose(), rotation.col(1).transpose(),
+        rotation.col(2).transpose();
+  }
+  const Eigen::VectorXd b = nn::inverse_mass_coefficients(body);
+  Eigen::VectorXd other_mass = b, other_moment = b;
+  other_mass[0] *= 5.0;    // 1 / m
+  other_moment[2] *= 1.5;  // 1 / I_y
+  EXPECT_LT(nn::tangent_mass_error(body, other_mass, body_x), 1e-12);
+  EXPECT_GT(nn::tangent_mass_error(body, other_moment, body_x), 0.01);
+  EXPECT_THROW(nn::tangent_mass_error(body, b.head(3), body_x), std::invalid_argument);
 }

@@ -222,13 +222,12 @@ TEST(ConstrainedTask, TheConstrainedModelsLearnTheirMassesWhenAsked) {
     const Eigen::VectorXd truth = nn::inverse_mass_coefficients(model->config().constraints);
     ASSERT_EQ(learned.size(), std::size_t(count)) << task;
     ASSERT_EQ(m.at("masses_true").size(), std::size_t(count)) << task;
-    double worst = 0;
     for (int k = 0; k < count; ++k) {
       EXPECT_NEAR(learned[std::size_t(k)] * c(0, k), 1.0, 1e-12) << task;
       EXPECT_NEAR(m["masses_true"][std::size_t(k)].get<double>() * truth[k], 1.0, 1e-12) << task;
-      worst = std::max(worst, std::abs(c(0, 0) / c(0, k) * truth[k] / truth[0] - 1));
     }
-    EXPECT_NEAR(m.at("masses_ratio_error").get<double>(), worst, 1e-12) << task;
+    // Drawn near 1, three steps from the start: they move the system otherwise than its own.
+    EXPECT_GT(m.at("masses_tangent_error").get<double>(), 1e-3) << task;
   }
   const nlohmann::json known = run_training(tiny("chnn", dir / "known"));
   EXPECT_FALSE(known.contains("masses_learned"));

@@ -168,11 +168,11 @@ std::string constrained_line(const json& m) {
                             number_at(m, "cartesian_error_rollouts").value_or(NAN));
 }
 
-// Learned masses (--masses learned) beside the system's, compared as ratios (the motion fixes
-// them up to a factor shared with the potential).
+// Learned masses (--masses learned) beside the system's, and how far apart they move it (the
+// motion fixes only part of them: metrics.json's masses_note).
 std::string masses_line(const json& m) {
-  const auto ratio = number_at(m, "masses_ratio_error");
-  if (!ratio) return "";
+  const auto error = number_at(m, "masses_tangent_error");
+  if (!error) return "";
   const auto list = [&](const char* key) {
     std::string out;
     for (const json& v : m.at(key))
@@ -180,8 +180,8 @@ std::string masses_line(const json& m) {
     return out;
   };
   return fmt::format(
-      "  masses     learned {} (true {}); ratios to the first off by {:.2g} at most\n",
-      list("masses_learned"), list("masses_true"), *ratio);
+      "  masses     learned {} (true {}); as they move the system, {:.2g} off up to a scale\n",
+      list("masses_learned"), list("masses_true"), *error);
 }
 
 std::string timing_line(const json& m) {
