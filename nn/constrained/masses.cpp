@@ -8,7 +8,6 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
-#include <unsupported/Eigen/KroneckerProduct>
 #include <utility>
 
 namespace hnn::nn {
@@ -163,32 +162,23 @@ Eigen::MatrixXd constraint_jacobian(const ConstraintSpec& spec, const Eigen::Row
   return g;
 }
 
-// M (x) I_d from inverse-mass coefficients c.
-Eigen::MatrixXd full_mass(const std::vector<Eigen::MatrixXd>& basis, const Eigen::VectorXd& c,
-                          Index d) {
-  Eigen::MatrixXd inverse = Eigen::MatrixXd::Zero(basis.front().rows(), basis.front().cols());
-  for (std::size_t k = 0; k < basis.size(); ++k) inverse += c[Index(k)] * basis[k];
-  const Eigen::MatrixXd m =
-      inverse.llt().solve(Eigen::MatrixXd::Identity(inverse.rows(), inverse.cols()));
-  return Eigen::kroneckerProduct(m, Eigen::MatrixXd::Identity(d, d));
-}
-
 }  // namespace
 
-double tangent_mass_error(const ConstraintSpec& spec, const Eigen::VectorXd& c,
-                          const Eigen::MatrixXd& positions) {
-  const std::vector<Eigen::MatrixXd> basis = inverse_mass_basis(spec);
-  if (c.size() != Index(basis.size()))
-    fail(fmt::format("{} coefficients for {} learned masses", c.size(), basis.size()));
-  const Eigen::MatrixXd learned = full_mass(basis, c, spec.dim),
-                        truth = full_mass(basis, inverse_mass_coefficients(spec), spec.dim);
+double tangent_mass_error(const ConstraintSpec& spec, const Eigen::MatrixXd& mass,
+                          const Eigen::MatrixXd& truth, const Eigen::MatrixXd& positions) {
+  const Index n = spec.positions();
+  if (mass.rows() != n || mass.cols() != n || truth.rows() != n || truth.cols() != n ||
+      positions.cols() != n)
+    throw std::invalid_argument(fmt::format(
+        "tangent_mass_error: masses {}x{} and {}x{}, positions {} wide, for {} coordinates",
+        mass.rows(), mass.cols(), truth.rows(), truth.cols(), positions.cols(), n));
   std::vector<Eigen::MatrixXd> l, t;  // reduced mass matrices at each row
   double cross = 0, square = 0;
   for (Index r = 0; r < positions.rows(); ++r) {
     const Eigen::JacobiSVD<Eigen::MatrixXd> svd(constraint_jacobian(spec, positions.row(r)),
                                                 Eigen::ComputeFullV);
-    const Eigen::MatrixXd tangent = svd.matrixV().rightCols(spec.positions() - svd.rank());
-    l.push_back(tangent.transpose() * learned * tangent);
+    const Eigen::MatrixXd tangent = svd.matrixV().rightCols(n - svd.rank());
+    l.push_back(tangent.transpose() * mass * tangent);
     t.push_back(tangent.transpose() * truth * tangent);
     cross += l.back().cwiseProduct(t.back()).sum();
     square += l.back().squaredNorm();

@@ -24,14 +24,15 @@ std::vector<Eigen::MatrixXd> inverse_mass_basis(const ConstraintSpec& spec);
 /// what a model with learned masses learns. Throws as inverse_mass_basis does.
 Eigen::VectorXd inverse_mass_coefficients(const ConstraintSpec& spec);
 
-/// How far the masses of inverse-mass coefficients c (size K) are from the spec's own where the
-/// motion can tell: on the tangent space of the position constraints at each row of `positions`
-/// (R x N d), the reduced mass matrix T^T (M (x) I_d) T (T an orthonormal basis of the tangent
-/// space), compared after the one best scale for all rows (M and V scaled together move alike):
-/// sqrt(sum_r |a M_r(c) - M_r(true)|^2 / sum_r |M_r(true)|^2). Zero for any c that moves the
-/// system as its own masses do: a pinned rigid body's mass and moments, say, matter only through
-/// its inertia about the pivot. Throws as inverse_mass_basis does, or for c of the wrong size.
-double tangent_mass_error(const ConstraintSpec& spec, const Eigen::VectorXd& c,
-                          const Eigen::MatrixXd& positions);
+/// How far the mass matrix `mass` is from `truth` (both M (x) I_d, N d x N d: ConstrainedMechanics'
+/// mass_matrix and mass) where the motion can tell: on the tangent space of the position
+/// constraints at each row of `positions` (R x N d), the reduced mass matrices T^T M T (T an
+/// orthonormal basis of the tangent space), compared after the one best scale for all rows (M and
+/// V scaled together move alike): sqrt(sum_r |a M_r - M_r(truth)|^2 / sum_r |M_r(truth)|^2).
+/// Zero for masses that move the system as the truth does: a pinned rigid body's mass and
+/// moments, say, matter only through its inertia about the pivot. Throws std::invalid_argument
+/// for shapes that do not fit the spec.
+double tangent_mass_error(const ConstraintSpec& spec, const Eigen::MatrixXd& mass,
+                          const Eigen::MatrixXd& truth, const Eigen::MatrixXd& positions);
 
 }  // namespace hnn::nn

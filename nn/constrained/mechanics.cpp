@@ -1,6 +1,9 @@
 #include "nn/constrained/mechanics.h"
 
+#include <fmt/format.h>
+
 #include <Eigen/Cholesky>
+#include <stdexcept>
 
 #include "autodiff/ops.h"
 #include "nn/constrained/masses.h"
@@ -161,6 +164,12 @@ typename ConstrainedMechanics<T>::MassOperators ConstrainedMechanics<T>::learned
 
 template <typename T>
 Matrix<T> ConstrainedMechanics<T>::mass_matrix(const Matrix<T>& c) const {
+  if (c.rows() != 1 || c.cols() != mass_coefficients()) {
+    throw std::invalid_argument(
+        fmt::format("constrained masses: coefficients {}x{} for {} learned "
+                    "masses",
+                    c.rows(), c.cols(), mass_coefficients()));
+  }
   Eigen::MatrixXd minv = Eigen::MatrixXd::Zero(spec_.points, spec_.points);
   for (std::size_t k = 0; k < point_basis_.size(); ++k)
     minv += double(c(0, Index(k))) * point_basis_[k];

@@ -63,14 +63,16 @@ json learned_mass_metrics(const nn::DynamicsModel<double>& model, const Batch& x
   const nn::ConstraintSpec& spec = model.config().constraints;
   if (constrained == nullptr || !spec.learned_masses) return json::object();
   // Coefficients c_k = 1 / (a mass or a moment); reported as the masses and moments themselves.
-  const Eigen::VectorXd c = constrained->inverse_mass_coefficients().row(0).transpose();
-  const Eigen::VectorXd learned = c.cwiseInverse(),
+  const Eigen::MatrixXd c = constrained->inverse_mass_coefficients();
+  const Eigen::VectorXd learned = c.row(0).cwiseInverse(),
                         truth = nn::inverse_mass_coefficients(spec).cwiseInverse();
+  const nn::ConstrainedMechanics<double>& mechanics = constrained->mechanics();
   const Eigen::Index rows = std::min<Eigen::Index>(x.rows(), kMassErrorStates);
   return {{"masses_learned", std::vector<double>(learned.begin(), learned.end())},
           {"masses_true", std::vector<double>(truth.begin(), truth.end())},
           {"masses_tangent_error",
-           number(nn::tangent_mass_error(spec, c, x.topLeftCorner(rows, spec.positions())))},
+           number(nn::tangent_mass_error(spec, mechanics.mass_matrix(c), mechanics.mass(),
+                                         x.topLeftCorner(rows, spec.positions())))},
           {"masses_note", kMassesNote}};
 }
 

@@ -94,8 +94,9 @@ void add_learned(Rollouts& r, const LearnedField& learned, const Batch& starts, 
       out.failure = e.what();
     }
   });
+  const Eigen::Index dim = starts.cols();
   for (LearnedPath& p : paths) {
-    const Eigen::Index i = Eigen::Index(r.pred.size()), dim = starts.cols();
+    const Eigen::Index i = Eigen::Index(r.pred.size());
     r.nfev += p.nfev;
     r.failed.push_back(!p.failure.empty());
     if (!p.failure.empty()) {

@@ -5,6 +5,7 @@
 #include "apps/hnn/commands/summary.h"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <algorithm>
 #include <cmath>
@@ -173,15 +174,11 @@ std::string constrained_line(const json& m) {
 std::string masses_line(const json& m) {
   const auto error = number_at(m, "masses_tangent_error");
   if (!error) return "";
-  const auto list = [&](const char* key) {
-    std::string out;
-    for (const json& v : m.at(key))
-      out += fmt::format("{}{:.4g}", out.empty() ? "" : ", ", v.get<double>());
-    return out;
-  };
   return fmt::format(
-      "  masses     learned {} (true {}); as they move the system, {:.2g} off up to a scale\n",
-      list("masses_learned"), list("masses_true"), *error);
+      "  masses     learned {:.4g} (true {:.4g}); as they move the system, {:.2g} off up to a "
+      "scale\n",
+      fmt::join(m.at("masses_learned").get<std::vector<double>>(), ", "),
+      fmt::join(m.at("masses_true").get<std::vector<double>>(), ", "), *error);
 }
 
 std::string timing_line(const json& m) {
