@@ -101,7 +101,22 @@ def machine_line(meta):
             f"model {meta.get('cpu_model', '?')}; {meta['cpus']} CPUs), hnn {meta['commit']};"
             f" FMA peak GFLOP/s: {peak_text or 'not measured'};"
             f" load average {meta['load_start']:.1f} at the start, {meta['load_end']:.1f} at the"
-            f" end; {meta['rounds']} rounds, medians; env: {meta['env']}.")
+            f" end; {meta['rounds']} rounds, medians; env: {meta['env']}.{peak_warning(meta)}")
+
+
+def peak_warning(meta, tolerance=0.9):
+    """A sentence when the FMA peak read before the runs and after them disagree: the machine
+    did not give the runs the same cores throughout, and their times are suspect."""
+    reads = meta.get("fma_peak_reads")
+    if not reads:
+        return ""
+    odd = [f"{dtype} at {t} thr {v:.0f} before, {reads['end'][dtype][t]:.0f} after"
+           for dtype, by in reads["start"].items() for t, v in by.items()
+           if min(v, reads["end"][dtype][t]) < tolerance * max(v, reads["end"][dtype][t])]
+    if not odd:
+        return ""
+    return (" **The FMA peak moved during this run** (" + "; ".join(odd) + "): the machine did"
+            " not give it the same cores throughout; repeat the comparison before quoting it.")
 
 
 def main_table(rows):

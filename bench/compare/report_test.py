@@ -50,6 +50,17 @@ class ReportTest(unittest.TestCase):
         self.assertIn("3.000 (slower than 1 thread)", text)
         self.assertIn("| c | 2.000 (1) | 5.000 (2) | 2.50x |", text)
 
+    def test_a_peak_that_moved_between_its_reads_is_reported(self):
+        meta = {"date": "d", "cpu": "AMD EPYC", "cpus": 2, "commit": "abc", "load_start": 0.1,
+                "load_end": 0.2, "rounds": 1, "env": "e", "fma_peak_gflops": self.peaks,
+                "fma_peak_reads": {"start": {"float64": {"2": 49.0, "1": 49.0}},
+                                   "end": {"float64": {"2": 98.0, "1": 48.0}}}}
+        text = markdown(meta, self.rows, self.best, [])
+        self.assertIn("The FMA peak moved during this run** (float64 at 2 thr 49 before, 98 after)",
+                      text)
+        meta["fma_peak_reads"]["end"]["float64"]["2"] = 50.0
+        self.assertNotIn("moved", markdown(meta, self.rows, self.best, []))
+
     def test_the_main_table_gives_hnn_s_op_count_per_step(self):
         self.assertEqual(self.row(1)["hnn"]["tape_nodes"], 32)
         self.assertNotIn("tape_nodes", self.row(1)["pytorch"])
