@@ -122,6 +122,11 @@ Var<T> batched_outer(const Var<T>& u, const Var<T>& v);
 /// exactly from the inverse), or of a non-finite right-hand side.
 template <typename T>
 Var<T> batched_spd_solve(const Var<T>& a, const Var<T>& b);
+/// The same solve for another right-hand side, reusing the factors of `factored`, an earlier
+/// batched_spd_solve(a, .) of this very `a` (checked: it throws otherwise). Constrained
+/// mechanics solves S twice per field, and every solve's backward solves it once more.
+template <typename T>
+Var<T> batched_spd_solve_factored(const Var<T>& a, const Var<T>& b, const Var<T>& factored);
 
 // ---- reductions and shapes -------------------------------------------------------------------
 template <typename T>

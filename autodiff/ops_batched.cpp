@@ -218,16 +218,22 @@ void solve_backward(const Node<T>& n, const Var<T>& g, GradSink<T>& s) {
 // ---- batched_matvec and batched_outer
 // ------------------------------------------------------------
 
-// y_r = op(A_r) v_r, with A_r k x n (or n x k, transposed) and n = v.cols().
+// y_r = op(A_r) v_r, with A_r k x n (or n x k, transposed) and n = v.cols(). Plain loops: the
+// blocks are a few constraints wide, where a per-row Eigen product spent its time dispatching.
 template <typename T>
 void matvec_rows(const Matrix<T>& a, const Matrix<T>& v, bool transpose, Matrix<T>& y) {
   const Eigen::Index n = v.cols(), k = a.cols() / n;
   y.resize(a.rows(), k);
   for (Eigen::Index r = 0; r < a.rows(); ++r) {
-    if (transpose)
-      y.row(r).noalias() = v.row(r) * RowMajorMap<T>(a.row(r).data(), n, k);
-    else
-      y.row(r).noalias() = v.row(r) * RowMajorMap<T>(a.row(r).data(), k, n).transpose();
+    const T* block = a.row(r).data();
+    const T* vr = v.row(r).data();
+    T* yr = y.row(r).data();
+    for (Eigen::Index i = 0; i < k; ++i) {
+      T sum = 0;
+      for (Eigen::Index j = 0; j < n; ++j)
+        sum += (transpose ? block[j * k + i] : block[i * n + j]) * vr[j];
+      yr[i] = sum;
+    }
   }
 }
 
@@ -284,9 +290,12 @@ Var<T> batched_outer(const Var<T>& u, const Var<T>& v) {
   const Eigen::Index n = u.cols(), m = v.cols();
   node.value.resize(u.rows(), n * m);
   for (Eigen::Index r = 0; r < u.rows(); ++r) {
-    Eigen::Map<Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
-        node.value.row(r).data(), n, m)
-        .noalias() = u.value().row(r).transpose() * v.value().row(r);
+    const T* ur = u.value().row(r).data();
+    const T* vr = v.value().row(r).data();
+    T* out = node.value.row(r).data();
+    for (Eigen::Index i = 0; i < n; ++i) {
+      for (Eigen::Index j = 0; j < m; ++j) out[i * m + j] = ur[i] * vr[j];
+    }
   }
   return Var<T>::of(node);
 }

@@ -9,6 +9,11 @@ namespace hnn::ad {
 
 namespace {
 
+// Multiply-adds below which a product stays on one thread: a parallel region (waking, claiming,
+// joining) costs about what a thread does in this many, and the small products of constrained
+// mechanics, a dozen per field evaluation, were each split in two.
+constexpr Eigen::Index kParallelProduct = Eigen::Index(1) << 17;
+
 // out = op(a) op(b) without materialising a transpose, through the fused kernels' GEMM, with
 // the output's rows (or, for a short wide output, its columns) split over the engine's threads.
 template <typename T>
@@ -20,7 +25,8 @@ void product(const Matrix<T>& a, const Matrix<T>& b, bool ta, bool tb, Matrix<T>
     return;
   }
   const bool by_rows = m >= n;
-  const int parts = parts_for(by_rows ? m : n);
+  const Eigen::Index multiply_adds = m * n * (ta ? a.rows() : a.cols());
+  const int parts = multiply_adds < kParallelProduct ? 1 : parts_for(by_rows ? m : n);
   parallel_for(parts, [&](int p) {
     const RowBlock r = row_block(by_rows ? m : n, parts, p);
     if (by_rows) {

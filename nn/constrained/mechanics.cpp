@@ -219,7 +219,7 @@ ad::Var<T> ConstrainedMechanics<T>::hamiltonian_field(const ad::Var<T>& z, const
   const ad::Var<T> k =
       ad::matmul(ad::batched_outer(g.w, g.e) - ad::batched_outer(g.e, g.w), masses.gram);
   const ad::Var<T> nu = ad::batched_spd_solve(g.s, r1);  // S nu = r1
-  const ad::Var<T> mu = ad::batched_spd_solve(g.s, ad::batched_matvec(k, nu) - r2);
+  const ad::Var<T> mu = ad::batched_spd_solve_factored(g.s, ad::batched_matvec(k, nu) - r2, nu);
   // z' = f - J DPsi^T (mu, nu): x' = v - M^-1 G^T nu, p' = -dV + G^T mu + Gdot^T nu.
   const ad::Var<T> nu_e = g.e * expand(nu);
   const ad::Var<T> x_dot = g.v - ad::matmul(nu_e, masses.to_velocity, false, true);

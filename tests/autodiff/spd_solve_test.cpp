@@ -1,6 +1,8 @@
 // batched_spd_solve: the solution against Eigen's Cholesky block by block, its derivatives
 // against finite differences to second order (also for blocks that are not symmetric, of which
-// it reads the symmetric part), and the errors that name the row of a block it cannot solve.
+// it reads the symmetric part), the errors that name the row of a block it cannot solve, the
+// same bits on one thread and two, and batched_spd_solve_factored, which reuses a solve's
+// factors for another right-hand side.
 
 #include <gtest/gtest.h>
 
@@ -110,4 +112,60 @@ TEST(BatchedSpdSolve, NamesTheRowOfABlockItCannotSolve) {
   EXPECT_NE(spd_solve_test::ErrorOf(SpdBlocks(4, 2, 8), random_matrix(4, 3, 10))
                 .find("do not match right-hand sides"),
             std::string::npos);
+}
+
+TEST(BatchedSpdSolve, GivesTheSameBitsOnOneThreadAndTwo) {
+  const MatrixD a = SpdBlocks(300, 3, 11), b = random_matrix(300, 3, 12);
+  const auto solve = [&](int threads) {
+    ad::set_num_threads(threads);
+    ad::TapeScope scope;
+    const MatrixD x =
+        ad::batched_spd_solve(Var<double>::constant(a), Var<double>::constant(b)).value();
+    ad::set_num_threads(2);
+    return x;
+  };
+  EXPECT_TRUE(solve(1) == solve(2));
+}
+
+// Constrained mechanics' pattern: a second solve of the same blocks whose right-hand side
+// depends on the first solution.
+TEST(BatchedSpdSolveFactored, EqualsAFreshSolveAndDifferentiatesToSecondOrder) {
+  for (Eigen::Index n : {1, 2, 3}) {
+    const MatrixD a = SpdBlocks(3, n, 13) + 0.1 * random_matrix(3, n * n, 14);
+    const MatrixD b1 = random_matrix(3, n, 15), b2 = random_matrix(3, n, 16);
+    {
+      ad::TapeScope scope;
+      const Var<double> av = Var<double>::constant(a);
+      const Var<double> first = ad::batched_spd_solve(av, Var<double>::constant(b1));
+      const Var<double> rhs = Var<double>::constant(b2);
+      EXPECT_TRUE(ad::batched_spd_solve_factored(av, rhs, first).value() ==
+                  ad::batched_spd_solve(av, rhs).value())
+          << n;
+    }
+    const auto f = [](const std::vector<Var<double>>& in) {
+      const Var<double> first = ad::batched_spd_solve(in[0], in[1]);
+      return ad::sum(ad::sin(ad::batched_spd_solve_factored(in[0], in[2] * first, first)));
+    };
+    const std::vector<MatrixD> inputs{a, b1, b2};
+    const ad::CheckResult first = ad::gradcheck(f, inputs);
+    EXPECT_TRUE(first.ok) << n << ": " << first.worst << "\n" << first.log;
+    const ad::CheckResult second = ad::gradgradcheck(f, inputs);
+    EXPECT_TRUE(second.ok) << n << ": " << second.worst << "\n" << second.log;
+  }
+}
+
+TEST(BatchedSpdSolveFactored, RefusesTheFactorsOfAnotherMatrix) {
+  ad::TapeScope scope;
+  const Var<double> a = Var<double>::constant(SpdBlocks(4, 2, 17));
+  const Var<double> other = Var<double>::constant(SpdBlocks(4, 2, 18));
+  const Var<double> b = Var<double>::constant(random_matrix(4, 2, 19));
+  const Var<double> solved = ad::batched_spd_solve(other, b);
+  try {
+    ad::batched_spd_solve_factored(a, b, solved);
+    FAIL() << "no error";
+  } catch (const ad::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("did not solve with this matrix"), std::string::npos)
+        << e.what();
+  }
+  EXPECT_THROW(ad::batched_spd_solve_factored(a, b, b), ad::Error);  // not a solve at all
 }
