@@ -79,9 +79,6 @@ Node<T>& value_node(const char* op) {
   return record<T>(op, std::span<const Var<T>>(), nullptr);
 }
 
-// Elements from which a partial gradients' sum is split over the threads.
-constexpr Index kParallelSum = Index(1) << 15;
-
 // The sum of the parts' partial gradients of one parameter, handed on as input `input`. One
 // part's is swapped into the node, not copied: the node's old buffer (this slot's gradient of the
 // last step, the same shape) becomes the part's next scratch, so nothing is allocated. Two
@@ -102,7 +99,7 @@ void add_reduced(std::vector<PartSpace<T>>& space, int parts,
     // way.
     g.value.resize(part(0).rows(), part(0).cols());
     const Index n = g.value.size();
-    const int blocks = n >= kParallelSum ? parts : 1;
+    const int blocks = n >= kParallelElements ? parts : 1;
     parallel_for(blocks, [&](int b) {
       const RowBlock e = element_block(n, blocks, b);
       const auto flat = [&](Matrix<T>& m) {

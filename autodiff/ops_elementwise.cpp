@@ -11,14 +11,6 @@ namespace hnn::ad {
 
 namespace {
 
-// Below this many elements an elementwise op runs on the calling thread: handing half to a
-// worker would cost more than the work. Above it (an LNN's 512 x 128 or 512 x 600 layers, whose
-// derivatives of any order are chains of elementwise ops between GEMMs) the rows are split across
-// the engine's threads as the GEMMs' are; left serial, these ops were a quarter of a 2-thread
-// LNN step at width 600 and most of it at width 128. (With workers that spin briefly between
-// jobs, Note [Brief spin], 2^15 measured best of 2^15, 2^16 and 2^18 on the LNN steps.)
-constexpr Eigen::Index kParallelElements = Eigen::Index(1) << 15;
-
 // body(first_row, row_count) over row blocks of a rows x cols result, concurrently when it is
 // big. Every element is computed by the same expression either way: results do not depend on
 // the split.

@@ -51,6 +51,15 @@ RowBlock row_block(Eigen::Index rows, int parts, int i);
 /// between 1 and 3 threads on a Zen 3.)
 RowBlock element_block(Eigen::Index n, int parts, int i);
 
+/// Below this many elements an elementwise pass (an op, a sum of gradients) runs on the calling
+/// thread: handing half to a worker would cost more than the work. Above it (an LNN's 512 x 128
+/// or 512 x 600 layers, whose derivatives of any order are chains of elementwise ops between
+/// GEMMs) the rows are split across the engine's threads as the GEMMs' are; left serial, these
+/// ops were a quarter of a 2-thread LNN step at width 600 and most of it at width 128. (With
+/// workers that spin briefly between jobs, Note [Brief spin], 2^15 measured best of 2^15, 2^16
+/// and 2^18 on the LNN steps.)
+inline constexpr Eigen::Index kParallelElements = Eigen::Index(1) << 15;
+
 /// How many parts a batch of `rows` is worth splitting into: one per thread, but at least
 /// `min_rows` rows each (below that, waking a thread costs more than it saves).
 int parts_for(Eigen::Index rows, Eigen::Index min_rows = 64);
