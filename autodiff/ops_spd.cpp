@@ -136,6 +136,14 @@ SpdFailure over_row_blocks(Eigen::Index rows, Block&& block) {
   return {};
 }
 
+// Records in the node which matrix its factors are of.
+template <typename T>
+void remember_matrix(Node<T>& node, const Var<T>& a) {
+  SpdFactors& owner = node.template state_for<SpdFactors>();
+  owner.matrix = &a.node();
+  owner.generation = a.node().generation;
+}
+
 // Factors every row of sym(A) into the node, checks it, and solves.
 template <typename T>
 SpdFailure factor_and_solve(const Var<T>& a, const Matrix<T>& b, Node<T>& node) {
@@ -143,9 +151,7 @@ SpdFailure factor_and_solve(const Var<T>& a, const Matrix<T>& b, Node<T>& node) 
   node.buffers.resize(std::size_t(1 + parts_for(rows)));
   node.buffers[kFactors].resize(rows, n * n);
   node.value.resize(rows, n);
-  SpdFactors& owner = node.template state_for<SpdFactors>();
-  owner.matrix = &a.node();
-  owner.generation = a.node().generation;
+  remember_matrix(node, a);
   return over_row_blocks(rows, [&](int p, RowBlock r) {
     Matrix<T>& column = node.buffers[std::size_t(1 + p)];
     column.resize(1, n);
@@ -160,9 +166,7 @@ SpdFailure solve_factored(const Node<T>& factored, const Var<T>& a, const Matrix
                           Node<T>& node) {
   node.buffers.resize(1);
   node.buffers[kFactors] = factored.buffers[kFactors];
-  SpdFactors& owner = node.template state_for<SpdFactors>();
-  owner.matrix = &a.node();
-  owner.generation = a.node().generation;
+  remember_matrix(node, a);
   node.value.resize(b.rows(), b.cols());
   return over_row_blocks(b.rows(), [&](int, RowBlock r) {
     return solve_block<T>(node.buffers[kFactors], b, node.value, r);
