@@ -37,24 +37,13 @@ auto hidden_block(const MlpLayers<T>& l, const std::vector<Matrix<T>>& buffers, 
   return h.middleRows(r.begin, r.size());
 }
 
-// out = in W_k (+ b_k). The bias is written first and the product added to it (beta = 1): a
-// beta = 0 GEMM zeroes its output in a pass of its own, and the bias was then a second one.
-template <typename T, typename In, typename Out>
-void affine_rows(const MlpLayers<T>& l, int k, const In& in, Out&& out) {
-  if (const Var<T>* b = l.bias(k)) {
-    out.rowwise() = b->value().row(0);
-    gemm(in, false, l.w(k), false, out, T(1));
-  } else {
-    gemm(in, false, l.w(k), false, out);
-  }
-}
-
 // h_k = tanh(h_{k-1} W_k + b_k) for the hidden layers, rows r, into buffers[k - 1].
 template <typename T>
 void hidden_rows(const MlpLayers<T>& l, std::vector<Matrix<T>>& buffers, RowBlock r) {
   for (int k = 1; k < l.count(); ++k) {
     auto out = buffers[std::size_t(k - 1)].middleRows(r.begin, r.size());
-    affine_rows(l, k, hidden_block(l, std::as_const(buffers), k - 1, r), out);
+    gemm(hidden_block(l, std::as_const(buffers), k - 1, r), false, l.w(k), false, out);
+    if (const Var<T>* b = l.bias(k)) out.rowwise() += b->value().row(0);
     tanh_in_place(out);
   }
 }
@@ -286,8 +275,9 @@ void tanh_mlp_forward(const MlpLayers<T>& l, Node<T>& node) {
   parallel_for(parts, [&](int p) {
     const RowBlock r = row_block(rows, parts, p);
     hidden_rows(l, node.buffers, r);
-    affine_rows(l, L, hidden_block(l, std::as_const(node.buffers), L - 1, r),
-                node.value.middleRows(r.begin, r.size()));
+    auto out = node.value.middleRows(r.begin, r.size());
+    gemm(hidden_block(l, std::as_const(node.buffers), L - 1, r), false, l.w(L), false, out);
+    if (const Var<T>* b = l.bias(L)) out.rowwise() += b->value().row(0);
   });
 }
 
