@@ -7,6 +7,7 @@
 
 #include "autodiff/ops.h"
 #include "autodiff/parallel.h"
+#include "autodiff/row_kernels.h"
 #include "autodiff/tape.h"
 
 namespace hnn::ad {
@@ -192,13 +193,7 @@ class Sweep : public GradSink<T> {
 
   // sum += g, split over the engine's threads when big (each element the same addition).
   static void add_in_place(Matrix<T>& sum, const Matrix<T>& g) {
-    const Eigen::Index n = sum.size();
-    const int parts = n >= kParallelElements ? parts_for(sum.rows()) : 1;
-    parallel_for(parts, [&](int p) {
-      const RowBlock e = element_block(n, parts, p);
-      Eigen::Map<Eigen::Array<T, Eigen::Dynamic, 1>>(sum.data() + e.begin, e.size()) +=
-          Eigen::Map<const Eigen::Array<T, Eigen::Dynamic, 1>>(g.data() + e.begin, e.size());
-    });
+    for_element_blocks(sum.size(), [&](RowBlock e) { detail::flat(sum, e) += detail::flat(g, e); });
   }
 
   std::uint64_t id_;

@@ -98,15 +98,9 @@ void add_reduced(std::vector<PartSpace<T>>& space, int parts,
     // idled the others for 1% of a CHNN step); each element is summed in the same order either
     // way.
     g.value.resize(part(0).rows(), part(0).cols());
-    const Index n = g.value.size();
-    const int blocks = n >= kParallelElements ? parts : 1;
-    parallel_for(blocks, [&](int b) {
-      const RowBlock e = element_block(n, blocks, b);
-      const auto flat = [&](Matrix<T>& m) {
-        return Eigen::Map<Eigen::Array<T, Eigen::Dynamic, 1>>(m.data() + e.begin, e.size());
-      };
-      flat(g.value) = flat(part(0)) + flat(part(1));
-      for (int p = 2; p < parts; ++p) flat(g.value) += flat(part(p));
+    for_element_blocks(g.value.size(), [&](RowBlock e) {
+      flat(g.value, e) = flat(part(0), e) + flat(part(1), e);
+      for (int p = 2; p < parts; ++p) flat(g.value, e) += flat(part(p), e);
     });
   }
   s.add(input, Var<T>::of(g));

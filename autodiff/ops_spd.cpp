@@ -29,10 +29,14 @@ struct SpdFailure {
 // spent their time dispatching).
 constexpr std::size_t kFactors = 0;
 
-// Per-node state: which matrix the factors belong to, so a later solve can reuse them.
+// Per-node state: which matrix the factors belong to, so a later solve can reuse them, and
+// where they are: the factoring node's buffer, which a solve that reuses them points at rather
+// than copies (every node involved lives on the same tape until it is rewound).
+template <typename T>
 struct SpdFactors : OpState {
-  const void* matrix = nullptr;
+  const Node<T>* matrix = nullptr;
   std::uint32_t generation = 0;
+  const Matrix<T>* factors = nullptr;
 };
 
 // False when a pivot is not positive (sym(A) is not positive definite).
@@ -136,12 +140,13 @@ SpdFailure over_row_blocks(Eigen::Index rows, Block&& block) {
   return {};
 }
 
-// Records in the node which matrix its factors are of.
+// Records in the node which matrix its factors are of, and where they are.
 template <typename T>
-void remember_matrix(Node<T>& node, const Var<T>& a) {
-  SpdFactors& owner = node.template state_for<SpdFactors>();
-  owner.matrix = &a.node();
-  owner.generation = a.node().generation;
+void remember_factors(Node<T>& node, const Var<T>& a, const Matrix<T>& factors) {
+  SpdFactors<T>& state = node.template state_for<SpdFactors<T>>();
+  state.matrix = &a.node();
+  state.generation = a.node().generation;
+  state.factors = &factors;
 }
 
 // Factors every row of sym(A) into the node, checks it, and solves.
@@ -151,7 +156,7 @@ SpdFailure factor_and_solve(const Var<T>& a, const Matrix<T>& b, Node<T>& node) 
   node.buffers.resize(std::size_t(1 + parts_for(rows)));
   node.buffers[kFactors].resize(rows, n * n);
   node.value.resize(rows, n);
-  remember_matrix(node, a);
+  remember_factors(node, a, node.buffers[kFactors]);
   return over_row_blocks(rows, [&](int p, RowBlock r) {
     Matrix<T>& column = node.buffers[std::size_t(1 + p)];
     column.resize(1, n);
@@ -159,18 +164,15 @@ SpdFailure factor_and_solve(const Var<T>& a, const Matrix<T>& b, Node<T>& node) 
   });
 }
 
-// Solves with the factors of `factored`, an earlier solve's node, copied into this node so that
-// its own backward reuses them in turn.
+// Solves with the factors of an earlier solve of `a`, which this node hands on to its own
+// backward in turn.
 template <typename T>
-SpdFailure solve_factored(const Node<T>& factored, const Var<T>& a, const Matrix<T>& b,
+SpdFailure solve_factored(const Matrix<T>& factors, const Var<T>& a, const Matrix<T>& b,
                           Node<T>& node) {
-  node.buffers.resize(1);
-  node.buffers[kFactors] = factored.buffers[kFactors];
-  remember_matrix(node, a);
+  remember_factors(node, a, factors);
   node.value.resize(b.rows(), b.cols());
-  return over_row_blocks(b.rows(), [&](int, RowBlock r) {
-    return solve_block<T>(node.buffers[kFactors], b, node.value, r);
-  });
+  return over_row_blocks(
+      b.rows(), [&](int, RowBlock r) { return solve_block<T>(factors, b, node.value, r); });
 }
 
 template <typename T>
@@ -231,14 +233,15 @@ template <typename T>
 Var<T> batched_spd_solve_factored(const Var<T>& a, const Var<T>& b, const Var<T>& factored) {
   check_shapes(a, b);
   const Node<T>& earlier = factored.node();
-  HNN_AD_CHECK(
-      earlier.template holds_state<SpdFactors>() &&
-          earlier.template state_as<SpdFactors>().matrix == &a.node() &&
-          earlier.template state_as<SpdFactors>().generation == a.node().generation,
-      "batched_spd_solve_factored: the factored solve given ({}) did not solve with this matrix",
-      earlier.op);
+  const SpdFactors<T>* state = earlier.template holds_state<SpdFactors<T>>()
+                                   ? &earlier.template state_as<SpdFactors<T>>()
+                                   : nullptr;
+  HNN_AD_CHECK(state && state->matrix == &a.node() && state->generation == a.node().generation,
+               "batched_spd_solve_factored: the factored solve given ({}) did not solve with this "
+               "matrix",
+               earlier.op);
   Node<T>& node = detail::record<T>("batched_spd_solve", {a, b}, spd_solve_backward<T>);
-  throw_spd_failure<T>(solve_factored<T>(earlier, a, b.value(), node), a.rows());
+  throw_spd_failure<T>(solve_factored<T>(*state->factors, a, b.value(), node), a.rows());
   return Var<T>::of(node);
 }
 

@@ -60,6 +60,16 @@ RowBlock element_block(Eigen::Index n, int parts, int i);
 /// and 2^18 on the LNN steps.)
 inline constexpr Eigen::Index kParallelElements = Eigen::Index(1) << 15;
 
+/// body(block) for the element blocks (element_block) of a flat array of n elements: one block on
+/// the calling thread below kParallelElements, one per thread above. For elementwise work, whose
+/// bits do not depend on the split.
+template <typename Body>
+void for_element_blocks(Eigen::Index n, const Body& body) {
+  const int parts = n >= kParallelElements ? num_threads() : 1;
+  if (parts == 1) return body(RowBlock{0, n});
+  parallel_for(parts, [&](int i) { body(element_block(n, parts, i)); });
+}
+
 /// How many parts a batch of `rows` is worth splitting into: one per thread, but at least
 /// `min_rows` rows each (below that, waking a thread costs more than it saves).
 int parts_for(Eigen::Index rows, Eigen::Index min_rows = 64);

@@ -5,6 +5,7 @@
 // cost as much as a GEMM of the MLP kernels.
 
 #include <Eigen/Core>
+#include <type_traits>
 
 namespace hnn::ad::detail {
 
@@ -35,6 +36,15 @@ void copy_cols(const Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic, Eigen::Row
   for (Eigen::Index i = 0; i < x.rows(); ++i) {
     for (Eigen::Index c = 0; c < count; ++c) to[i * out_stride + c] = in[i * in_stride + c];
   }
+}
+
+/// Elements [block.begin, block.end) of m in storage order, as a 1-D array. (Eigen's reshaped()
+/// walks a row-major matrix by columns: a strided pass.)
+template <typename M, typename Block>
+auto flat(M& m, const Block& block) {
+  using Array = Eigen::Array<typename M::Scalar, Eigen::Dynamic, 1>;
+  using Mapped = std::conditional_t<std::is_const_v<M>, const Array, Array>;
+  return Eigen::Map<Mapped>(m.data() + block.begin, block.end - block.begin);
 }
 
 /// Every row of out = row (1 x cols).

@@ -166,9 +166,8 @@ template <typename T>
 Matrix<T> ConstrainedMechanics<T>::mass_matrix(const Matrix<T>& c) const {
   if (c.rows() != 1 || c.cols() != mass_coefficients()) {
     throw std::invalid_argument(
-        fmt::format("constrained masses: coefficients {}x{} for {} learned "
-                    "masses",
-                    c.rows(), c.cols(), mass_coefficients()));
+        fmt::format("constrained masses: coefficients {}x{} for {} learned masses", c.rows(),
+                    c.cols(), mass_coefficients()));
   }
   Eigen::MatrixXd minv = Eigen::MatrixXd::Zero(spec_.points, spec_.points);
   for (std::size_t k = 0; k < point_basis_.size(); ++k)
