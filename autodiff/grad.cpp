@@ -52,6 +52,12 @@ class BorrowedBuffers {
   SweepBuffers<T>* buffers_;
 };
 
+// sum += g, split over the engine's threads when big (each element the same addition).
+template <typename T>
+void add_in_place(Matrix<T>& sum, const Matrix<T>& g) {
+  for_element_blocks(sum.size(), [&](RowBlock e) { detail::flat(sum, e) += detail::flat(g, e); });
+}
+
 // One reverse sweep: finds the nodes between the outputs and the targets, then propagates
 // gradients through them in reverse creation order (a reverse topological order).
 template <typename T>
@@ -189,11 +195,6 @@ class Sweep : public GradSink<T> {
       acc = ad::add(acc, g);
       owned_[slot] = !grad_enabled();
     }
-  }
-
-  // sum += g, split over the engine's threads when big (each element the same addition).
-  static void add_in_place(Matrix<T>& sum, const Matrix<T>& g) {
-    for_element_blocks(sum.size(), [&](RowBlock e) { detail::flat(sum, e) += detail::flat(g, e); });
   }
 
   std::uint64_t id_;
