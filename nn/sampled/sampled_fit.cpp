@@ -61,6 +61,9 @@ void check_inputs(const DynamicsConfig& config, const Matrix<double>& x,
         "layer's weights; train it with Adam",
         to_string(config.model)));
   }
+  if (config.hidden.empty()) {
+    throw std::invalid_argument("sampled fit: the MLP has no hidden layer to sample");
+  }
   check_matrix("x", x, config.dim);
   check_matrix("dxdt", dxdt, config.dim);
   if (x.rows() != dxdt.rows()) {
@@ -70,6 +73,30 @@ void check_inputs(const DynamicsConfig& config, const Matrix<double>& x,
 }
 
 // The hidden layers and the last layer's weights (unknowns x m) of one fit.
+// The last layer's least-squares problem, known before anything is sampled: the baseline fits
+// each output over the points, the other models one field equation per point and coordinate.
+// Checked first, so that a width the data cannot support fails at once, not after the sampling
+// and --rcond auto's fold solves (seconds at width 1000 on the spring).
+struct LastLayerShape {
+  Index equations, unknowns;
+};
+
+LastLayerShape last_layer_shape(const DynamicsConfig& mc, Index points) {
+  const Index width = mc.hidden.back();
+  if (mc.model == ModelKind::kBaseline) return {points, width};
+  return {points * mc.dim, Index(sampled::field_terms(mc).size()) * width};
+}
+
+void check_width(const DynamicsConfig& mc, Index points) {
+  const LastLayerShape shape = last_layer_shape(mc, points);
+  if (shape.unknowns > shape.equations) {
+    throw std::invalid_argument(fmt::format(
+        "sampled fit: {} last-layer unknowns per output but only {} equations from {} points; "
+        "lower the width or give more points",
+        shape.unknowns, shape.equations, points));
+  }
+}
+
 struct Fitted {
   std::vector<HiddenLayer> layers;
   ColMat last_hidden;  // the last hidden layer's outputs at the data (N x width), when kept
@@ -148,11 +175,11 @@ Fitted fit_once(const DynamicsConfig& mc, const ColMat& x, const ColMat& dxdt,
   report.assemble_seconds += seconds_from(start);
   report.rows = std::size_t(system->equations() * system->rhs_columns());
   report.columns = std::size_t(system->unknowns() * system->rhs_columns());
-  if (system->unknowns() > system->equations()) {
-    throw std::invalid_argument(fmt::format(
-        "sampled fit: {} last-layer unknowns per output but only {} equations from {} points; "
-        "lower the width or give more points",
-        system->unknowns(), system->equations(), x.rows()));
+  const LastLayerShape expected = last_layer_shape(mc, x.rows());
+  if (system->unknowns() != expected.unknowns || system->equations() != expected.equations) {
+    throw std::logic_error(fmt::format(
+        "sampled fit: the last layer's system is {} x {}, not the {} x {} checked beforehand",
+        system->equations(), system->unknowns(), expected.equations, expected.unknowns));
   }
   const sampled::LeastSquaresResult solved = sampled::solve_least_squares(*system, solve, &whole);
   report.assemble_seconds += solved.gram_seconds;
@@ -197,6 +224,7 @@ SampledFitReport fit_sampled(DynamicsModel<T>& model, const Matrix<double>& x,
                              const Matrix<double>& dxdt, const SampledFitConfig& config) {
   const DynamicsConfig& mc = model.config();
   check_inputs(mc, x, dxdt);
+  check_width(mc, x.rows());
   SampledFitReport report;
   report.solver = std::string(name_of(kLeastSquaresSolverNames, config.solver));
   const ColMat xc = x, dc = dxdt;

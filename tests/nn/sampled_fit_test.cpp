@@ -196,6 +196,10 @@ TEST(SampledFit, RefusesWhatItCannotFit) {
   for (Index i = 3; i < 300; ++i) three.x.row(i) = three.x.row(i % 3);
   refuses(model_config(ModelKind::kHnn, {250}), three, "distinct point pairs");
   refuses(model_config(ModelKind::kBaseline, {80}), pendulum(60, 2), "unknowns");
+  // An HNN's equations are the points times the field's coordinates: 120 here.
+  refuses(model_config(ModelKind::kHnn, {121}), pendulum(60, 2),
+          "121 last-layer unknowns per output but only 120 equations from 60 points");
+  refuses(model_config(ModelKind::kHnn, {}), train, "no hidden layer to sample");
   Problem bad = train;
   bad.dxdt(7, 1) = std::nan("");
   refuses(model_config(ModelKind::kHnn, {20}), bad, "dxdt row 7 column 1 is not finite");
