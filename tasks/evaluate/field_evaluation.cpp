@@ -3,7 +3,6 @@
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 
 #include "autodiff/tape.h"
@@ -129,11 +128,8 @@ json rollout_metrics(const Rollouts& r, double threshold) {
 FieldEvaluation evaluate_field_model(const physics::System& truth,
                                      const nn::DynamicsModel<double>& model, const Dataset& data,
                                      const Batch& x0, const RolloutConfig& config) {
-  const auto start = std::chrono::steady_clock::now();
   FieldEvaluation e = evaluate_field_model(model, data, make_rollouts(truth, model, x0, config));
   e.metrics.update(hamiltonian_error_metrics(truth, learned_field(model), data.test_x));
-  e.metrics["eval_seconds"] =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return e;
 }
 
@@ -155,28 +151,20 @@ json point_metrics(const nn::DynamicsModel<double>& model, const Dataset& data) 
   return m;
 }
 
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
 }  // namespace
 
 FieldEvaluation evaluate_field_model(const nn::DynamicsModel<double>& model, const Dataset& data,
                                      Rollouts rollouts) {
-  const auto start = std::chrono::steady_clock::now();
   FieldEvaluation e{.metrics = point_metrics(model, data), .rollouts = std::move(rollouts)};
   e.metrics.update(rollout_metrics(e.rollouts));
-  e.metrics["eval_seconds"] = seconds_since(start);
   return e;
 }
 
 FieldEvaluation evaluate_field_points(const physics::System* truth,
                                       const nn::DynamicsModel<double>& model, const Dataset& data) {
-  const auto start = std::chrono::steady_clock::now();
   FieldEvaluation e{.metrics = point_metrics(model, data)};
   if (truth) e.metrics.update(hamiltonian_error_metrics(*truth, learned_field(model), data.test_x));
   e.metrics["rollouts_skipped"] = kRolloutsSkipped;
-  e.metrics["eval_seconds"] = seconds_since(start);
   return e;
 }
 

@@ -17,7 +17,7 @@ namespace hnn::tasks {
 
 struct FieldEvaluation {
   /// Train/test loss and energy MSE with standard errors, R^2 of each split (1 - MSE / variance
-  /// of the targets), counts, time.
+  /// of the targets), counts. (How long it took is the run's eval_seconds: tasks/run.cpp.)
   nlohmann::json metrics{};
   Rollouts rollouts{};
 };

@@ -7,7 +7,6 @@
 #include <fmt/ranges.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 
 #include "physics/integrator.h"
@@ -53,7 +52,6 @@ class FieldRun : public FieldModelRun {
       m["training"] = training_.loss().to_json();
       return m;
     }
-    const auto start = std::chrono::steady_clock::now();
     const RolloutConfig config = evaluation_rollouts();
     FieldEvaluation e =
         task_.has_truth()
@@ -68,8 +66,6 @@ class FieldRun : public FieldModelRun {
                       config.trajectories, asked_rollouts_, config.trajectories);
     }
     task_.add_metrics(e.rollouts, e.metrics);
-    e.metrics["eval_seconds"] =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (folder)
       folder->write_text("rollout.csv", tasks::rollout_csv(e.rollouts, nn::to_string(s_.model)));
     json m = e.metrics;

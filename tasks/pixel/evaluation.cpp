@@ -5,7 +5,6 @@
 
 #include <fmt/format.h>
 
-#include <chrono>
 #include <cmath>
 
 #include "physics/integrator.h"
@@ -23,10 +22,6 @@ namespace {
 
 json stats_json(const nn::MeanStderr& s) {
   return {{"mean", number(s.mean)}, {"se", number(s.std_error)}};
-}
-
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
 std::string rollout_csv(const PixelRollouts& r) {
@@ -133,7 +128,6 @@ void write_pixel_files(const PixelModel<double>& model, const PixelData& data,
 
 json evaluate_pixel_model(const PixelModel<double>& model, const PixelData& data,
                           const PixelConfig& config, const RunFolder* folder) {
-  const auto start = std::chrono::steady_clock::now();
   json m = loss_metrics(pixel_loss_stats(model, data, false, config.hnn_weight),
                         pixel_loss_stats(model, data, true, config.hnn_weight));
   const PixelRollouts r = pixel_rollouts(model, data, config, 2);
@@ -141,7 +135,6 @@ json evaluate_pixel_model(const PixelModel<double>& model, const PixelData& data
   m["n_train"] = data.train_rows();
   m["n_test"] = data.test_rows;
   if (folder) write_pixel_files(model, data, r, *folder);
-  m["eval_seconds"] = seconds_since(start);
   return m;
 }
 
