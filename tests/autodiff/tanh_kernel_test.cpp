@@ -82,4 +82,24 @@ TEST(TanhKernel, SaturatesAndPropagatesNan) {
   EXPECT_TRUE(std::isnan(ad::tanh(Var<double>::constant(nan)).value()(0, 0)));
 }
 
+// Double precision: within a few ulps of 1 of the true tanh everywhere (the formulas subtract
+// from 1, so a tiny tanh(x) ~ x is good to an absolute 1e-16, not to its own last bit), and
+// increasing where neighbouring points differ by more than that.
+TEST(TanhKernel, DoubleIsWithinAFewUlpsOfOneOfTheTrueTanh) {
+  ad::TapeScope scope;
+  ad::Matrix<double> x(1, 4001);
+  for (Eigen::Index i = 0; i < x.cols(); ++i) {
+    const double u = double(i - 2000) / 2000.0;                              // -1..1
+    x(0, i) = std::copysign(std::pow(10.0, -12.0 + 13.5 * std::abs(u)), u);  // up to 10^1.5
+  }
+  const ad::Matrix<double> y = ad::tanh(Var<double>::constant(x)).value();
+  double worst = 0;
+  for (Eigen::Index i = 0; i < x.cols(); ++i) {
+    const long double truth = std::tanh(static_cast<long double>(x(0, i)));
+    worst = std::max(worst, double(std::abs(static_cast<long double>(y(0, i)) - truth)));
+    if (i > 0 && std::abs(x(0, i)) < 5) EXPECT_LT(y(0, i - 1), y(0, i)) << x(0, i);
+  }
+  EXPECT_LT(worst, 4 * std::numeric_limits<double>::epsilon());
+}
+
 }  // namespace
