@@ -7,7 +7,6 @@
 #include <functional>
 #include <random>
 
-#include "autodiff/parallel.h"
 #include "nn/hnn.h"
 #include "physics/integrator.h"
 #include "tasks/evaluate/energy_errors.h"
@@ -15,7 +14,6 @@
 #include "tasks/evaluate/loss_stats.h"
 #include "tasks/evaluate/rollouts.h"
 #include "tasks/evaluate/state_errors.h"
-#include "tasks/evaluate/stretch_predictions.h"
 #include "tasks/experiments/registry.h"
 #include "tasks/field/field_task.h"
 #include "tasks/train/field_objective.h"
@@ -243,45 +241,6 @@ TEST(MakeRollouts, BlowUpIsRecordedAsAFailureAndLeftOutOfTheMetrics) {
       EXPECT_NEAR(r.pred[std::size_t(i)](Eigen::Index(k), 0), want, 1e-7);
     }
   }
-}
-
-// Stretches predicted one at a time (adaptive steps, as the data task asks): each gets its own
-// path, the same at any thread count, and a stretch that blows up fails alone, at its place.
-TEST(PredictPaths, OneAtATimeGivesEachStretchItsOwnPathAndFailure) {
-  const FunctionModel explosive(2, [](const Batch& x) {  // dq/dt = q^2: q0 / (1 - q0 t)
-    Batch dxdt = Batch::Zero(x.rows(), 2);
-    dxdt.col(0) = x.col(0).array().square();
-    return dxdt;
-  });
-  std::vector<Stretch> stretches;
-  for (double q0 : {-1.0, 2.0, -0.5, 0.25, -2.0}) {
-    Batch x = Batch::Zero(11, 2);
-    x(0, 0) = q0;
-    stretches.push_back({Eigen::VectorXd::LinSpaced(11, 0.0, 1.0), x});
-  }
-  const Predictor predict = model_predictor(explosive, {});
-  const int previous = ad::num_threads();
-  std::vector<PredictedPaths> by_threads;
-  for (int threads : {1, 2}) {
-    ad::set_num_threads(threads);
-    by_threads.push_back(predict_paths(stretches, predict, /*batch=*/false));
-  }
-  ad::set_num_threads(previous);
-  for (const PredictedPaths& p : by_threads) {
-    ASSERT_EQ(p.paths.size(), stretches.size());
-    EXPECT_EQ(p.failed(), 1);
-    EXPECT_FALSE(p.failures[1].empty());  // q0 = 2 blows up at t = 0.5
-    EXPECT_TRUE(p.paths[1].array().isNaN().all());
-    for (std::size_t i : {0u, 2u, 3u, 4u}) {
-      EXPECT_TRUE(p.failures[i].empty()) << p.failures[i];
-      const double q0 = stretches[i].x(0, 0);
-      for (Eigen::Index k = 0; k < 11; ++k) {
-        const double t = stretches[i].t(k);
-        EXPECT_NEAR(p.paths[i](k, 0), q0 / (1 - q0 * t), 1e-7 * (1 + std::abs(q0)));
-      }
-    }
-  }
-  for (std::size_t i : {0u, 2u, 3u, 4u}) EXPECT_EQ(by_threads[0].paths[i], by_threads[1].paths[i]);
 }
 
 // Rollouts with given per-trajectory energy errors: pred_energy - true_energy = sqrt(v_i) at
