@@ -37,7 +37,7 @@ inline __m256d tanh_avx2(__m256d x) {
   __m256d r = _mm256_fmadd_pd(k, c(-0.693145751953125), y);
   r = _mm256_fmadd_pd(k, c(-1.4286068203094172321e-6), r);
   const __m256d r2 = _mm256_mul_pd(r, r), r4 = _mm256_mul_pd(r2, r2), r8 = _mm256_mul_pd(r4, r4);
-  const __m256d p01 = _mm256_fmadd_pd(r, c(1.0), c(1.0));
+  const __m256d p01 = _mm256_add_pd(r, c(1.0));
   const __m256d p23 = _mm256_fmadd_pd(r, c(1.0 / 6), c(0.5));
   const __m256d p45 = _mm256_fmadd_pd(r, c(1.0 / 120), c(1.0 / 24));
   const __m256d p67 = _mm256_fmadd_pd(r, c(1.0 / 5040), c(1.0 / 720));

@@ -72,7 +72,6 @@ void check_inputs(const DynamicsConfig& config, const Matrix<double>& x,
   }
 }
 
-// The hidden layers and the last layer's weights (unknowns x m) of one fit.
 // The last layer's least-squares problem, known before anything is sampled: the baseline fits
 // each output over the points, the other models one field equation per point and coordinate.
 // Checked first, so that a width the data cannot support fails at once, not after the sampling
@@ -97,6 +96,7 @@ void check_width(const DynamicsConfig& mc, Index points) {
   }
 }
 
+// The hidden layers and the last layer's weights (unknowns x m) of one fit.
 struct Fitted {
   std::vector<HiddenLayer> layers;
   ColMat last_hidden;  // the last hidden layer's outputs at the data (N x width), when kept
