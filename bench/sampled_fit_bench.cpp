@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 #include <sys/resource.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <numbers>
@@ -122,6 +123,9 @@ int main(int argc, char** argv) try {
   fit.regularization =
       std::stod(arg(argc, argv, "regularization", fmt::format("{}", fit.regularization)));
   if (const std::string r = arg(argc, argv, "rcond", "auto"); r != "auto") fit.rcond = std::stod(r);
+  if (const std::string s = arg(argc, argv, "swim-scale", "auto"); s != "auto") {
+    fit.swim_scale = std::stod(s);
+  }
   fit.tolerance = std::stod(arg(argc, argv, "tolerance", fmt::format("{}", fit.tolerance)));
   fit.max_iterations =
       std::stoi(arg(argc, argv, "max-iterations", fmt::format("{}", fit.max_iterations)));
@@ -136,7 +140,10 @@ int main(int argc, char** argv) try {
   config.hidden.assign(std::size_t(layers), width);
   std::mt19937_64 init(1);
   nn::Hnn<double> model(config, init);
+  const auto start = std::chrono::steady_clock::now();
   const nn::SampledFitReport r = nn::fit_sampled(model, tr.x, tr.dxdt, fit);
+  const double wall =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
   const Eigen::VectorXd h = model.energy(te.x).col(0);
   const Eigen::VectorXd diff = h - te.h;
@@ -154,13 +161,15 @@ int main(int argc, char** argv) try {
       "\"fit_seconds\": {:.2f}, \"sample_seconds\": {:.2f}, \"assemble_seconds\": {:.2f}, "
       "\"gram_seconds\": {:.2f}, \"solve_seconds\": {:.2f}, \"iterations\": {}, \"rows\": {}, "
       "\"columns\": {}, \"matrix_gb\": {:.2f}, \"peak_rss_gb\": {:.2f}, \"gram_gflops\": {:.1f}, "
-      "\"residual_rms\": {:.3e}, \"rcond\": {:g}, \"validation_seconds\": {:.2f}}}\n",
+      "\"residual_rms\": {:.3e}, \"rcond\": {:g}, \"validation_seconds\": {:.2f}, \"swim_scale\": "
+      "{:.4g}, "
+      "\"wall_seconds\": {:.2f}}}\n",
       arg(argc, argv, "system", "hh"), nn::name_of(nn::kHiddenSamplerNames, fit.sampler), r.solver,
       width, layers, train, shifted, pinned,
       r.sample_seconds + r.assemble_seconds + r.solve_seconds, r.sample_seconds, r.assemble_seconds,
       r.gram_seconds, r.solve_seconds, r.iterations, r.rows, r.columns,
       double(r.matrix_bytes) / 1e9, peak_rss_gb(), syrk_flops / r.gram_seconds * 1e-9,
-      r.residual_rms, r.rcond, r.validation_seconds);
+      r.residual_rms, r.rcond, r.validation_seconds, r.swim_scale, wall);
   return 0;
 } catch (const std::exception& e) {
   fmt::print(stderr, "sampled_fit_bench: {}\n", e.what());

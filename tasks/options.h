@@ -85,8 +85,9 @@ struct RunSettings {
   /// by resolve() (tasks/run.h): what the field tasks train with. task_settings keeps them as
   /// given, so that metrics.json and checkpoints record them as before.
   RolloutLossConfig loss{};
-  /// The fit keys of task_settings ("fit", "sampler", "rcond"), parsed once by resolve(): Adam,
-  /// or sampled hidden layers with the last layer by least squares (tasks/train/fit_method.h).
+  /// The fit keys of task_settings ("fit", "sampler", "swim_scale", "rcond", ...), parsed once by
+  /// resolve(): Adam, or sampled hidden layers with the last layer by least squares
+  /// (tasks/train/fit_method.h).
   FitConfig fit{};
 
   /// The form metrics.json and checkpoints hold ("hidden": "200-200").

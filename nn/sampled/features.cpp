@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "autodiff/parallel.h"
+#include "autodiff/tanh_kernel.h"
 
 namespace hnn::nn::sampled {
 
@@ -71,6 +72,15 @@ void activate(Activation activation, const ColMat& z, ColMat& value, ColMat* slo
   const int parts = ad::parts_for(z.size(), 1 << 14);
   ad::parallel_for(parts, [&](int part) {
     const ad::RowBlock block = ad::row_block(z.size(), parts, part);
+    if (activation == Activation::kTanh) {      // the engine's vectorised kernel: libm's scalar
+      const Index n = block.end - block.begin;  // tanh was most of a fit's assembly
+      ad::detail::tanh_values(z.data() + block.begin, value.data() + block.begin, n);
+      if (slope) {
+        slope->reshaped().segment(block.begin, n) =
+            1 - value.reshaped().segment(block.begin, n).array().square();
+      }
+      return;
+    }
     double df = 0;
     for (Index k = block.begin; k < block.end; ++k) {
       activate_one(activation, z.data()[k], value.data()[k], slope ? slope->data()[k] : df);

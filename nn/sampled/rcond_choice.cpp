@@ -187,11 +187,10 @@ void merge_halves(Fold& fold, ReducedProblem& whole) {
 }  // namespace
 
 double choose_rcond(const SystemOn& system_on, const std::vector<PointSplit>& folds,
-                    LeastSquaresSolver solver, std::vector<RcondTrial>& curve,
-                    ReducedProblem* whole) {
+                    LeastSquaresSolver solver, const std::vector<double>& ladder,
+                    std::vector<RcondTrial>& curve, ReducedProblem* whole) {
   const bool merge = whole != nullptr && folds.size() == 1;
   const BlasThreads threads;
-  const std::vector<double> ladder = rcond_ladder();
   std::vector<double> squared(ladder.size(), 0.0);
   std::vector<int> ranks(ladder.size(), 0);
   double target = 0;
@@ -232,6 +231,20 @@ double choose_rcond(const SystemOn& system_on, const std::vector<PointSplit>& fo
     }
   }
   return chosen;
+}
+
+double held_out_error(const SystemOn& system_on, const std::vector<PointSplit>& folds,
+                      const SampledFitConfig& config) {
+  double squared = 0, target = 0;
+  for (const PointSplit& split : folds) {
+    const ColMat c = solve_least_squares(*system_on(split.train), config).c;
+    const std::unique_ptr<LinearSystem> held_out = system_on(split.held_out);
+    ColMat fitted(held_out->equations(), held_out->rhs_columns());
+    held_out->apply(c, fitted);
+    squared += (fitted - held_out->rhs()).squaredNorm();
+    target += held_out->rhs().squaredNorm();
+  }
+  return std::sqrt(squared / (target > 0 ? target : 1.0));
 }
 
 }  // namespace hnn::nn::sampled

@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <memory>
+#include <optional>
 #include <random>
 #include <stdexcept>
 
@@ -13,6 +14,7 @@
 #include "nn/sampled/least_squares.h"
 #include "nn/sampled/rcond_choice.h"
 #include "nn/sampled/samplers.h"
+#include "nn/sampled/scale_choice.h"
 
 namespace hnn::nn {
 
@@ -104,12 +106,12 @@ struct Fitted {
 };
 
 std::vector<HiddenLayer> sample_hidden(const DynamicsConfig& mc, const ColMat& x,
-                                       HiddenSampler sampler, const ColMat* target,
+                                       HiddenSampler sampler, double scale, const ColMat* target,
                                        std::mt19937_64& rng, ColMat* last_hidden) {
   std::vector<HiddenLayer> layers;
   ColMat h = sampled::mlp_input(mc, x);
   for (Index width : mc.hidden) {
-    layers.push_back(sampled::sample_layer(h, width, sampler, mc.activation, target, rng));
+    layers.push_back(sampled::sample_layer(h, width, sampler, mc.activation, scale, target, rng));
     if (layers.size() == mc.hidden.size() && !last_hidden) break;
     ColMat value;
     sampled::activate(mc.activation, sampled::pre_activation(layers.back(), h), value, nullptr);
@@ -148,40 +150,104 @@ std::unique_ptr<sampled::LinearSystem> last_layer_system(const DynamicsConfig& m
   return std::make_unique<sampled::HadamardSystem>(std::move(slope), std::move(v), dxdt);
 }
 
-// keep_last: the last hidden layer's outputs are needed (the baseline's matrix, A-SWIM's target).
-Fitted fit_once(const DynamicsConfig& mc, const ColMat& x, const ColMat& dxdt,
-                const SampledFitConfig& config, HiddenSampler sampler, const ColMat* target,
-                bool keep_last, std::mt19937_64& rng, SampledFitReport& report) {
+// What one fit_once samples from and for. keep_last: the last hidden layer's outputs are
+// needed (the baseline's matrix, A-SWIM's target).
+struct FitRequest {
+  const DynamicsConfig& mc;
+  const ColMat &x, &dxdt;
+  const SampledFitConfig& config;
+  HiddenSampler sampler;
+  const ColMat* target;
+  bool keep_last;
+};
+
+// The hidden layers sampled at one SWIM scale, validated when the cutoff is auto or the scale is
+// being chosen: the cutoff chosen, its curve, the held-out error and the whole problem's triangle
+// the validation left (one fold), which the fit at the chosen cutoff starts from.
+struct Trial {
   Fitted fit;
+  std::optional<double> rcond;
+  std::vector<RcondTrial> rcond_curve;
+  sampled::ReducedProblem whole;
+  double error = 0;
+};
+
+Trial sample_trial(const FitRequest& q, double scale, bool score, std::mt19937_64& rng,
+                   SampledFitReport& report) {
+  Trial t;
   auto start = Clock::now();
-  fit.layers = sample_hidden(mc, x, sampler, target, rng, keep_last ? &fit.last_hidden : nullptr);
+  t.fit.layers = sample_hidden(q.mc, q.x, q.sampler, scale, q.target, rng,
+                               q.keep_last ? &t.fit.last_hidden : nullptr);
   report.sample_seconds += seconds_from(start);
-  SampledFitConfig solve = config;
-  sampled::ReducedProblem whole;  // auto's validation leaves the whole problem reduced
-  if (reads_rcond(config.solver) && !config.rcond) {
-    start = Clock::now();
-    const auto on = [&](const std::vector<Index>& rows) {
-      const ColMat hidden =
-          mc.model == ModelKind::kBaseline ? ColMat(fit.last_hidden(rows, Eigen::all)) : ColMat();
-      return last_layer_system(mc, fit.layers, hidden, x(rows, Eigen::all), dxdt(rows, Eigen::all));
-    };
-    solve.rcond = sampled::choose_rcond(on, sampled::validation_folds(x.rows()), config.solver,
-                                        report.rcond_validation, &whole);
-    report.validation_seconds += seconds_from(start);
-  }
-  report.rcond = solve.rcond.value_or(0);
+  t.rcond = q.config.rcond;
+  const bool rcond_auto = reads_rcond(q.config.solver) && !q.config.rcond;
+  if (!rcond_auto && !score) return t;
   start = Clock::now();
-  const auto system = last_layer_system(mc, fit.layers, fit.last_hidden, x, dxdt);
+  const auto on = [&](const std::vector<Index>& rows) {
+    const ColMat hidden =
+        q.mc.model == ModelKind::kBaseline ? ColMat(t.fit.last_hidden(rows, Eigen::all)) : ColMat();
+    return last_layer_system(q.mc, t.fit.layers, hidden, q.x(rows, Eigen::all),
+                             q.dxdt(rows, Eigen::all));
+  };
+  const std::vector<sampled::PointSplit> folds = sampled::validation_folds(q.x.rows());
+  if (reads_rcond(q.config.solver)) {
+    const std::vector<double> ladder =
+        rcond_auto ? sampled::rcond_ladder() : std::vector<double>{*q.config.rcond};
+    t.rcond = sampled::choose_rcond(on, folds, q.config.solver, ladder, t.rcond_curve, &t.whole);
+    t.error = std::ranges::min_element(t.rcond_curve, {}, &RcondTrial::error)->error;
+  } else {
+    t.error = sampled::held_out_error(on, folds, q.config);
+  }
+  report.validation_seconds += seconds_from(start);
+  return t;
+}
+
+// The hidden layers at the configured SWIM scale, or with --swim-scale auto at the scale of the
+// smallest held-out error (scale_choice.h); every scale draws the same pairs, so only the scale
+// differs between them, and rng ends where the chosen one's draws left it.
+Trial sampled_layers(const FitRequest& q, std::mt19937_64& rng, SampledFitReport& report) {
+  if (!reads_swim_scale(q.sampler, q.mc.activation) || q.config.swim_scale) {
+    const double scale = q.config.swim_scale.value_or(kPeerSwimScale);
+    report.swim_scale = reads_swim_scale(q.sampler, q.mc.activation) ? scale : 0;
+    return sample_trial(q, scale, false, rng, report);
+  }
+  std::optional<Trial> best;
+  std::mt19937_64 after = rng;
+  const auto error_at = [&](double scale) {
+    std::mt19937_64 draws = rng;
+    Trial t = sample_trial(q, scale, true, draws, report);
+    const double error = t.error;
+    if (!best || error < best->error) {  // the walk's own rule: ties to the first tried
+      best = std::move(t);
+      after = draws;
+    }
+    return error;
+  };
+  report.swim_scale = sampled::walk_scales(error_at, report.scale_validation);
+  rng = after;
+  return std::move(*best);
+}
+
+Fitted fit_once(const FitRequest& q, std::mt19937_64& rng, SampledFitReport& report) {
+  Trial trial = sampled_layers(q, rng, report);
+  report.rcond = trial.rcond.value_or(0);
+  if (reads_rcond(q.config.solver) && !q.config.rcond) report.rcond_validation = trial.rcond_curve;
+  SampledFitConfig solve = q.config;
+  solve.rcond = trial.rcond;
+  Fitted& fit = trial.fit;
+  const auto start = Clock::now();
+  const auto system = last_layer_system(q.mc, fit.layers, fit.last_hidden, q.x, q.dxdt);
   report.assemble_seconds += seconds_from(start);
   report.rows = std::size_t(system->equations() * system->rhs_columns());
   report.columns = std::size_t(system->unknowns() * system->rhs_columns());
-  const LastLayerShape expected = last_layer_shape(mc, x.rows());
+  const LastLayerShape expected = last_layer_shape(q.mc, q.x.rows());
   if (system->unknowns() != expected.unknowns || system->equations() != expected.equations) {
     throw std::logic_error(fmt::format(
         "sampled fit: the last layer's system is {} x {}, not the {} x {} checked beforehand",
         system->equations(), system->unknowns(), expected.equations, expected.unknowns));
   }
-  const sampled::LeastSquaresResult solved = sampled::solve_least_squares(*system, solve, &whole);
+  const sampled::LeastSquaresResult solved =
+      sampled::solve_least_squares(*system, solve, &trial.whole);
   report.assemble_seconds += solved.gram_seconds;
   report.gram_seconds += solved.gram_seconds;
   report.solve_seconds += solved.solve_seconds;
@@ -190,7 +256,7 @@ Fitted fit_once(const DynamicsConfig& mc, const ColMat& x, const ColMat& dxdt,
   report.residual_rms = solved.residual_rms;
   report.matrix_bytes = std::max(report.matrix_bytes, system->bytes() + solved.bytes);
   fit.c = solved.c;
-  return fit;
+  return std::move(fit);
 }
 
 // The fitted MLP's outputs at the data (N x outputs): A-SWIM's approximate target.
@@ -236,11 +302,18 @@ SampledFitReport fit_sampled(DynamicsModel<T>& model, const Matrix<double>& x,
     for (Index& w : first.hidden)
       w = std::max<Index>(1, Index(std::lround(double(w) * config.aswim_first_fraction)));
   }
-  Fitted fit = fit_once(first, xc, dc, config, adaptive ? HiddenSampler::kUswim : config.sampler,
-                        nullptr, baseline || adaptive, rng, report);
+  const FitRequest first_request{first,
+                                 xc,
+                                 dc,
+                                 config,
+                                 adaptive ? HiddenSampler::kUswim : config.sampler,
+                                 nullptr,
+                                 baseline || adaptive};
+  Fitted fit = fit_once(first_request, rng, report);
   if (adaptive) {
     const ColMat approximate = fitted_outputs(fit);
-    fit = fit_once(mc, xc, dc, config, HiddenSampler::kAswim, &approximate, baseline, rng, report);
+    fit =
+        fit_once({mc, xc, dc, config, HiddenSampler::kAswim, &approximate, baseline}, rng, report);
   }
   write_weights(model, fit);
   return report;

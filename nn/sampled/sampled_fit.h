@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "nn/activation.h"
 #include "nn/dynamics.h"
 #include "nn/enum_names.h"
 
@@ -52,9 +53,19 @@ constexpr bool reads_rcond(LeastSquaresSolver solver) {
   return solver != LeastSquaresSolver::kLsqr && solver != LeastSquaresSolver::kCholesky;
 }
 
-/// Settings of a sampled fit. The defaults reproduce the peer's accuracy (docs/sampled.md).
+/// The peer's SWIM scale, atanh(1/2) = ln(3) / 2: a tanh neuron passes through -1/2 and +1/2 at
+/// its two data points (swimnetworks' Dense).
+inline constexpr double kPeerSwimScale = 0.54930614433405484570;
+
+/// Settings of a sampled fit. The defaults reproduce the peer's accuracy or better
+/// (docs/sampled.md).
 struct SampledFitConfig {
   HiddenSampler sampler = HiddenSampler::kUswim;
+  /// SWIM: a neuron's pre-activation runs from -swim_scale to +swim_scale between its two data
+  /// points (the peer's kPeerSwimScale); smaller, smoother neurons. Empty (auto, the default):
+  /// chosen by validation like rcond, walking kPeerSwimScale * 2^k from k = 0 while the held-out
+  /// error falls (scale_choice.h). ELM does not read it.
+  std::optional<double> swim_scale{};
   /// kQr, kRidge: singular values below rcond times the largest do not shape the solution (the
   /// peer's np.linalg.lstsq rcond; kQr drops them, kRidge damps them). Empty (auto, the default):
   /// chosen by validation on held-out tenths of the points, then the fit runs again on all of them
@@ -88,6 +99,20 @@ struct RcondTrial {
   int rank = 0;
 };
 
+/// Whether a fit reads SampledFitConfig::swim_scale: SWIM with tanh or sigmoid (the other
+/// activations place a neuron's data points at 0 and 1 of their own curve).
+constexpr bool reads_swim_scale(HiddenSampler sampler, Activation activation) {
+  return sampler != HiddenSampler::kElm &&
+         (activation == Activation::kTanh || activation == Activation::kSigmoid);
+}
+
+/// One scale of --swim-scale auto's walk: the held-out relative field error of the fit at it
+/// (at its best cutoff, when rcond is auto too).
+struct ScaleTrial {
+  double scale = 0;
+  double error = 0;
+};
+
 /// What a fit did, for metrics.json and the closing figures.
 struct SampledFitReport {
   std::string solver;            // the least-squares method that ran
@@ -103,7 +128,9 @@ struct SampledFitReport {
   int iterations = 0;            // of an iterative solver; 0 for a direct one
   double rcond = 0;              // kQr, kRidge: the cutoff used (auto: the one chosen)
   std::vector<RcondTrial> rcond_validation;  // auto: every cutoff tried (the last fit's)
-  double validation_seconds = 0;             // auto: choosing the cutoff (not in the others)
+  double swim_scale = 0;                     // SWIM: the scale used (auto: the one chosen)
+  std::vector<ScaleTrial> scale_validation;  // auto: every scale tried (the last fit's)
+  double validation_seconds = 0;  // auto: choosing the cutoff and scale (not in the others)
 };
 
 /// Samples every hidden layer of `model` and solves its last layer so that model.field(x)

@@ -59,7 +59,7 @@ std::vector<Index> draw_distinct(std::vector<double> p, Index width, std::mt1993
 }  // namespace
 
 HiddenLayer sample_layer(const ColMat& u, Index width, HiddenSampler sampler, Activation activation,
-                         const ColMat* target, std::mt19937_64& rng) {
+                         double scale, const ColMat* target, std::mt19937_64& rng) {
   if (sampler == HiddenSampler::kElm) return sample_elm(u, width, rng);
   const Index n = u.rows();
   if (n < 3) {
@@ -93,9 +93,9 @@ HiddenLayer sample_layer(const ColMat& u, Index width, HiddenSampler sampler, Ac
         "points; lower the width or give more data",
         width, usable, n));
   }
-  // tanh maps u_from to -s and u_to to +s, s = atanh(1/2) (the peer's constant); sigmoid the
-  // same points of its own curve; the relu family maps them to 0 and 1.
-  const double s = 0.5 * (std::log(1.5) - std::log(0.5));
+  // tanh maps u_from to -s and u_to to +s (the peer's s = atanh(1/2)); sigmoid the same points of
+  // its own curve; the relu family maps them to 0 and 1.
+  const double s = scale;
   double gain = 1, shift = 0;
   if (activation == Activation::kTanh) gain = 2 * s, shift = -s;
   if (activation == Activation::kSigmoid) gain = 4 * s, shift = -2 * s;

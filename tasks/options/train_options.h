@@ -29,6 +29,7 @@ enum class ValueKind {
   kPositiveReal,    ///< a finite number > 0
   kFraction,        ///< a number in (0, 1)
   kAutoOrFraction,  ///< "auto" or a number in (0, 1)
+  kAutoOrPositive,  ///< "auto" or a finite number > 0
   kFile,            ///< a file's name
   kFolder,          ///< a folder's name (made when missing)
   kRunFolder,       ///< an existing run folder

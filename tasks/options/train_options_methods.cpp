@@ -97,6 +97,17 @@ const TrainOption kMethodOptions[] = {
      .key = "sampler",
      .choices = sampler_names,
      .noun = "sampler"},
+    {.name = "swim-scale",
+     .kind = ValueKind::kAutoOrPositive,
+     .help = "How steep uswim's and aswim's tanh or sigmoid neurons are: each neuron's "
+             "pre-activation runs from -s to +s between its two data points, s a number > 0 (the "
+             "peer's atanh(1/2) = 0.549; smaller, smoother neurons), or auto: the scale of "
+             "0.549 * 2^k (k = -5 ... 2), walked from 0.549 while the field error on a held-out "
+             "tenth of the points falls, then refitted on all (default auto)",
+     .group = kFitGroup,
+     .sweep_rank = 38,
+     .applies_to = AppliesTo::kFieldTasks,
+     .key = "swim_scale"},
     {.name = "rcond",
      .kind = ValueKind::kAutoOrFraction,
      .help = "qr's and ridge's least-squares cutoff: singular values below rcond times the "

@@ -30,6 +30,16 @@ std::optional<double> rcond_setting(const json& s, const std::string& task) {
   return rcond;
 }
 
+// "swim_scale": "auto" (chosen by validation, nn/sampled/scale_choice.h; also when absent) or a
+// finite number > 0.
+std::optional<double> swim_scale_setting(const json& s, const std::string& task) {
+  const auto it = s.find("swim_scale");
+  if (it == s.end() || *it == "auto") return std::nullopt;
+  HNN_TASKS_CHECK(it->is_number() && std::isfinite(it->get<double>()) && it->get<double>() > 0,
+                  "{}: --swim-scale must be auto or a finite number > 0, got {}", task, it->dump());
+  return it->get<double>();
+}
+
 }  // namespace
 
 std::string fit_option_name(std::string key) {
@@ -42,13 +52,9 @@ std::vector<std::string> sampler_names() { return nn::names_of(nn::kHiddenSample
 std::vector<std::string> solver_names() { return nn::names_of(nn::kLeastSquaresSolverNames); }
 
 const std::vector<std::string>& fit_setting_names() {
-  static const std::vector<std::string> names = {"fit",
-                                                 "sampler",
-                                                 "rcond",
-                                                 "solver",
-                                                 "regularization",
-                                                 "solver_tolerance",
-                                                 "solver_iterations"};
+  static const std::vector<std::string> names = {
+      "fit",    "sampler",        "swim_scale",       "rcond",
+      "solver", "regularization", "solver_tolerance", "solver_iterations"};
   return names;
 }
 
@@ -73,12 +79,17 @@ FitConfig fit_config(const json& s, const std::string& task) {
     throw Error(fmt::format("{}: bad fit settings {}: {}", task, s.dump(), e.what()));
   }
   c.sampled.rcond = rcond_setting(s, task);
+  c.sampled.swim_scale = swim_scale_setting(s, task);
   for (const std::string& key : fit_setting_names()) {
     HNN_TASKS_CHECK(c.samples() || key == "fit" || !s.contains(key),
                     "{}: --{} applies to a sampled fit only (add --fit sampled or --fit "
                     "sampled+adam)",
                     task, fit_option_name(key));
   }
+  HNN_TASKS_CHECK(c.sampled.sampler != nn::HiddenSampler::kElm || !s.contains("swim_scale"),
+                  "{}: --swim-scale does not apply to --sampler elm (it draws weights at random, "
+                  "not from pairs of points; uswim and aswim read it)",
+                  task);
   check_fraction(c.sampled.tolerance, "solver_tolerance", task);
   HNN_TASKS_CHECK(c.sampled.regularization > 0 && std::isfinite(c.sampled.regularization),
                   "{}: --regularization must be a finite number > 0, got {}", task,
@@ -99,29 +110,41 @@ json rcond_curve(const std::vector<nn::RcondTrial>& curve) {
   return out;
 }
 
+// --swim-scale auto's walk: [{"scale": 0.549, "error": 1e-5}, ...]; empty otherwise.
+json scale_curve(const std::vector<nn::ScaleTrial>& curve) {
+  json out = json::array();
+  for (const nn::ScaleTrial& t : curve)
+    out.push_back({{"scale", t.scale}, {"error", number(t.error)}});
+  return out;
+}
+
 }  // namespace
 
 json fit_report_json(const FitConfig& config, const nn::SampledFitReport& r) {
-  return {{"method", config.name()},
-          {"sampler", nn::name_of(nn::kHiddenSamplerNames, config.sampled.sampler)},
-          {"rcond", config.sampled.rcond ? json(*config.sampled.rcond) : json("auto")},
-          {"rcond_used", r.rcond > 0 ? json(r.rcond) : json()},  // null: a solver without it
-          {"rcond_validation", rcond_curve(r.rcond_validation)},
-          {"validation_seconds", r.validation_seconds},
-          {"solver", r.solver},
-          {"regularization", config.sampled.regularization},
-          {"regularization_used", r.regularization},
-          {"solver_tolerance", config.sampled.tolerance},
-          {"solver_iterations", config.sampled.max_iterations},
-          {"sample_seconds", r.sample_seconds},
-          {"assemble_seconds", r.assemble_seconds},
-          {"solve_seconds", r.solve_seconds},
-          {"gram_seconds", r.gram_seconds},
-          {"rows", r.rows},
-          {"columns", r.columns},
-          {"matrix_bytes", r.matrix_bytes},
-          {"residual_rms", number(r.residual_rms)},
-          {"iterations", r.iterations}};
+  return {
+      {"method", config.name()},
+      {"sampler", nn::name_of(nn::kHiddenSamplerNames, config.sampled.sampler)},
+      {"swim_scale", config.sampled.swim_scale ? json(*config.sampled.swim_scale) : json("auto")},
+      {"swim_scale_used", r.swim_scale > 0 ? json(r.swim_scale) : json()},  // null: not read
+      {"swim_scale_validation", scale_curve(r.scale_validation)},
+      {"rcond", config.sampled.rcond ? json(*config.sampled.rcond) : json("auto")},
+      {"rcond_used", r.rcond > 0 ? json(r.rcond) : json()},  // null: a solver without it
+      {"rcond_validation", rcond_curve(r.rcond_validation)},
+      {"validation_seconds", r.validation_seconds},
+      {"solver", r.solver},
+      {"regularization", config.sampled.regularization},
+      {"regularization_used", r.regularization},
+      {"solver_tolerance", config.sampled.tolerance},
+      {"solver_iterations", config.sampled.max_iterations},
+      {"sample_seconds", r.sample_seconds},
+      {"assemble_seconds", r.assemble_seconds},
+      {"solve_seconds", r.solve_seconds},
+      {"gram_seconds", r.gram_seconds},
+      {"rows", r.rows},
+      {"columns", r.columns},
+      {"matrix_bytes", r.matrix_bytes},
+      {"residual_rms", number(r.residual_rms)},
+      {"iterations", r.iterations}};
 }
 
 }  // namespace hnn::tasks

@@ -56,7 +56,8 @@ std::vector<BadOption> bad_train_options() {
        "real-pendulum)"},
       {{"train", "spring", "--settings", "{\"trials\": 20}"},
        "task 'spring' has no setting 'trials' (known: loss, horizon, integrator, dt, norm, "
-       "minibatches, baseline_output, masses, fit, sampler, rcond, solver, regularization, "
+       "minibatches, baseline_output, masses, fit, sampler, swim_scale, rcond, solver, "
+       "regularization, "
        "solver_tolerance, "
        "solver_iterations, sample_dt, "
        "t_end, rollouts, rollout_t_end)"},
@@ -274,7 +275,7 @@ TEST(TrainOptionsTable, TheSweepKeysAreItsRowsInRankOrderAndTheOthersAreRefusedW
       "trajectory": "traj", "split": "time", "test-fraction": 0.3, "hamiltonian": "q^2",
       "loss": "rollout", "horizon": 2, "integrator": "leapfrog", "dt": 0.05, "norm": "l1",
       "minibatches": "epochs",
-      "fit": "sampled+adam", "sampler": "aswim", "rcond": 1e-10, "solver": "qr",
+      "fit": "sampled+adam", "sampler": "aswim", "swim-scale": 0.2, "rcond": 1e-10, "solver": "qr",
       "regularization": 1e-9, "solver-tolerance": 1e-10, "solver-iterations": 50,
       "baseline-output": "field", "masses": "known"})");
   json spec = json::object();
@@ -370,9 +371,13 @@ TEST(TrainOptionsTable, TheJsonFormReadsBackAsItWasWrittenAndOldRunsGetTheRecord
 // Adam run's settings do not change (no key of the fit).
 TEST(TrainOptionsTable, ASampledFitsSettingsReadBackAsWrittenAndAdamRunsKeepTheirs) {
   const std::unique_ptr<tasks::Task> task = tasks::make_task("spring");
-  const json given = {{"fit", "sampled"},       {"sampler", "aswim"},
-                      {"rcond", 1e-10},         {"solver", "qr"},
-                      {"regularization", 1e-9}, {"solver_tolerance", 1e-10},
+  const json given = {{"fit", "sampled"},
+                      {"sampler", "aswim"},
+                      {"swim_scale", 0.2},
+                      {"rcond", 1e-10},
+                      {"solver", "qr"},
+                      {"regularization", 1e-9},
+                      {"solver_tolerance", 1e-10},
                       {"solver_iterations", 50}};
   const tasks::RunSettings s = tasks::resolve(
       *task, {.task = "spring", .hidden = std::vector<int>{30}, .task_settings = given});
@@ -385,6 +390,7 @@ TEST(TrainOptionsTable, ASampledFitsSettingsReadBackAsWrittenAndAdamRunsKeepThei
   EXPECT_EQ(back.fit.sampled.sampler, nn::HiddenSampler::kAswim);
   EXPECT_EQ(back.fit.sampled.solver, nn::LeastSquaresSolver::kQr);
   EXPECT_EQ(back.fit.sampled.rcond, 1e-10);
+  EXPECT_EQ(back.fit.sampled.swim_scale, 0.2);
   EXPECT_EQ(back.fit.sampled.regularization, 1e-9);
   EXPECT_EQ(back.fit.sampled.tolerance, 1e-10);
   EXPECT_EQ(back.fit.sampled.max_iterations, 50);

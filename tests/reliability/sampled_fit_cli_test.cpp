@@ -48,6 +48,7 @@ std::vector<BadOption> bad_fit_options() {
   for (const std::vector<std::string>& option :
        std::vector<std::vector<std::string>>{{"--sampler", "elm"},
                                              {"--rcond", "1e-10"},
+                                             {"--swim-scale", "0.1"},
                                              {"--solver", "qr"},
                                              {"--regularization", "1e-8"},
                                              {"--solver-tolerance", "1e-8"},
@@ -82,6 +83,13 @@ std::vector<BadOption> bad_fit_options() {
        "spring: --rcond must be auto or a number in (0, 1), got \"often\""},
       {{"train", "spring", "--fit", "sampled", "--settings", R"({"rcond": 2})"},
        "spring: --rcond must be in (0, 1), got 2"},
+      {{"train", "spring", "--fit", "sampled", "--swim-scale", "0"},
+       "--swim-scale: expected auto or a finite number > 0, got '0'"},
+      {{"train", "spring", "--fit", "sampled", "--settings", R"({"swim_scale": "steep"})"},
+       "spring: --swim-scale must be auto or a finite number > 0, got \"steep\""},
+      {{"train", "spring", "--fit", "sampled", "--sampler", "elm", "--swim-scale", "0.1"},
+       "spring: --swim-scale does not apply to --sampler elm (it draws weights at random, not "
+       "from pairs of points; uswim and aswim read it)"},
       {{"train", "spring", "--fit", "sampled", "--regularization", "0"},
        "--regularization: expected a finite number > 0, got '0'"},
       {{"train", "spring", "--fit", "sampled", "--solver-iterations", "0"},

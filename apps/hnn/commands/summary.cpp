@@ -73,6 +73,21 @@ std::string rcond_line(const json& fit) {
       error_at(curve->back()), number_at(curve->back(), "rcond").value_or(NAN));
 }
 
+// "  swim scale auto chose 0.0343 (held-out field error 2.1e-10; 1.6e-06 at 0.549)", for
+// --swim-scale auto; "" otherwise. Its time is in the rcond line's (or is the validation's).
+std::string swim_scale_line(const json& fit) {
+  const auto curve = fit.find("swim_scale_validation");
+  if (curve == fit.end() || !curve->is_array() || curve->empty()) return "";
+  const double chosen = number_at(fit, "swim_scale_used").value_or(NAN);
+  double chosen_error = NAN;
+  for (const json& trial : *curve)
+    if (number_at(trial, "scale") == chosen) chosen_error = number_at(trial, "error").value_or(NAN);
+  return fmt::format(
+      "  swim scale auto chose {:.3g} (held-out field error {:.3g}; {:.3g} at {:.3g})\n", chosen,
+      chosen_error, number_at(curve->front(), "error").value_or(NAN),
+      number_at(curve->front(), "scale").value_or(NAN));
+}
+
 // "  fit        sampling 0.01 s, forming the matrix 0.02 s, solving 0.1 s (qr, rcond 1e-13):
 // 2000 x 100 system, 1.6 MB, residual 1.2e-05", and the rcond line.
 std::string fit_line(const json& m) {
@@ -88,7 +103,7 @@ std::string fit_line(const json& m) {
              seconds("sample_seconds"), seconds("assemble_seconds"), seconds("solve_seconds"),
              solver, text_at(*fit, "rows"), text_at(*fit, "columns"), seconds("matrix_bytes") / 1e6,
              seconds("residual_rms")) +
-         rcond_line(*fit);
+         swim_scale_line(*fit) + rcond_line(*fit);
 }
 
 // "  loss     test 3.1e-02 ± 1e-03, train 3e-02 ± 1e-03; R² test 0.998, train 0.999".

@@ -144,6 +144,7 @@ std::string metavar(const tasks::TrainOption& option) {
     case ValueKind::kFraction:
       return "X";
     case ValueKind::kAutoOrFraction:
+    case ValueKind::kAutoOrPositive:
       return "auto|X";
     case ValueKind::kFile:
       return "FILE";
@@ -189,6 +190,8 @@ CLI::Option* add_option(CLI::App& cmd, const tasks::TrainOption& option, Given& 
           ->check(CLI::Range(0.0, 1.0).description("in (0, 1)"));
     case ValueKind::kAutoOrFraction:
       return cmd.add_option(name, given.text, help)->check(auto_or_fraction());
+    case ValueKind::kAutoOrPositive:
+      return cmd.add_option(name, given.text, help)->check(auto_or_positive());
     case ValueKind::kColumns:
       return cmd.add_option(name, given.texts, help)->delimiter(',');
     case ValueKind::kRunFolder:
@@ -213,7 +216,8 @@ nlohmann::json given_value(const tasks::TrainOption& option, const Given& given)
     case ValueKind::kPositiveReal:
     case ValueKind::kFraction:
       return given.real;
-    case ValueKind::kAutoOrFraction:  // checked by auto_or_fraction()
+    case ValueKind::kAutoOrFraction:  // checked by auto_or_fraction() or auto_or_positive()
+    case ValueKind::kAutoOrPositive:
       return given.text == "auto" ? nlohmann::json("auto") : nlohmann::json(std::stod(given.text));
     case ValueKind::kColumns:
       return given.texts;

@@ -74,4 +74,17 @@ inline CLI::Validator auto_or_fraction() {
       "AUTO|X");
 }
 
+/// "auto", or a finite number > 0 (--swim-scale).
+inline CLI::Validator auto_or_positive() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        double value = 0;
+        if (text == "auto" ||
+            (detail::parse_whole(text, value) && std::isfinite(value) && value > 0))
+          return "";
+        return "expected auto or a finite number > 0, got '" + text + "'";
+      },
+      "AUTO|X");
+}
+
 }  // namespace hnn::app

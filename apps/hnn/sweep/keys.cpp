@@ -128,6 +128,11 @@ ordered_json checked_value(const TrainOption& key, const ordered_json& v) {
       if (v == "auto" || (v.is_number() && v.get<double>() > 0 && v.get<double>() < 1)) return v;
       throw std::invalid_argument(
           fmt::format("expected \"auto\" or a number in (0, 1), got {}", v.dump()));
+    case ValueKind::kAutoOrPositive:
+      if (v == "auto" || (v.is_number() && std::isfinite(v.get<double>()) && v.get<double>() > 0))
+        return v;
+      throw std::invalid_argument(
+          fmt::format("expected \"auto\" or a finite number > 0, got {}", v.dump()));
     case ValueKind::kFile:
       if (v.is_string() && !v.get<std::string>().empty())
         return fs::absolute(v.get<std::string>()).lexically_normal().string();

@@ -57,7 +57,7 @@ def load(path, *, angles=0, kinetic_prior=1.0):
 # fit's options by what takes them, with their defaults.
 _ADAM = {"steps": 1000, "lr": 1e-3, "batch": 0, "record_every": 1, "weight_decay": 0.0}
 _ROLLOUT = {"horizon": 1, "integrator": "rk4", "dt": 0.0}
-_SAMPLED = ("sampler", "rcond", "solver", "regularization", "solver_tolerance",
+_SAMPLED = ("sampler", "swim_scale", "rcond", "solver", "regularization", "solver_tolerance",
             "solver_iterations")
 
 
@@ -85,7 +85,8 @@ def _fit(self, x, target, *, loss="derivative", fit="adam", seed=0, callback=Non
     Ctrl-C stops after the current step, raising KeyboardInterrupt with the model at that step.
     fit="sampled" (the derivative loss; not an LNN) samples the hidden layers from the data and
     solves the last layer by least squares, without backpropagation: sampler (uswim, aswim,
-    elm), rcond ("auto", the default, or a number), solver (qr, the default; lsqr, cholesky),
+    elm), swim_scale ("auto", the default, or a number > 0: how steep a SWIM neuron is), rcond
+    ("auto", the default, or a number), solver (qr, the default; lsqr, cholesky),
     regularization, solver_tolerance,
     solver_iterations as `hnn train --fit sampled` takes them; its history is the one loss
     after the solve. fit="sampled+adam" samples, then trains with Adam as fit="adam".

@@ -53,7 +53,8 @@ class Model:
             callback: Optional[Callable[[int, float], object]] = None, steps: int = 1000,
             lr: float = 1e-3, batch: int = 0, record_every: int = 1, weight_decay: float = 0.0,
             horizon: int = 1, integrator: str = "rk4", dt: float = 0.0, sampler: str = "uswim",
-            rcond: Union[str, float] = "auto", solver: str = "qr", regularization: float = 1e-13,
+            swim_scale: Union[str, float] = "auto", rcond: Union[str, float] = "auto",
+            solver: str = "qr", regularization: float = 1e-13,
             solver_tolerance: float = 1e-14, solver_iterations: int = 200) -> np.ndarray: ...
     def rollout(self, x0: ArrayLike, t: ArrayLike, integrator: str = "dopri5",
                 rtol: float = 1e-9, dt: float = 1e-2) -> np.ndarray: ...

@@ -1,0 +1,25 @@
+#pragma once
+// --swim-scale auto (docs/sampled.md, "The SWIM scale"): how steep a SWIM neuron is between its
+// two data points, chosen by validation. The peer's scale (atanh(1/2)) suits none of its three
+// protocols best: Henon-Heiles, a cubic, wants neurons 8-30 times smoother (their near-linear
+// stretches combine into polynomials), the double pendulum about twice as steep. The walk starts
+// at the peer's scale and halves it while the held-out error falls, or else doubles it, so a fit
+// costs three to six fits of the validation fold rather than one per scale of a grid.
+
+#include <functional>
+#include <vector>
+
+#include "nn/sampled/sampled_fit.h"
+
+namespace hnn::nn::sampled {
+
+/// The scales the walk may reach: kPeerSwimScale * 2^k, k = -5 ... 2, smallest first.
+std::vector<double> swim_scale_ladder();
+
+/// Walks swim_scale_ladder() from kPeerSwimScale: down while each scale's held-out error
+/// (`error_at`) is below the best so far, then, if the first step down was no better, up the same
+/// way. Returns the scale of the smallest error (ties to the first tried) and every scale tried,
+/// in order, in `curve`.
+double walk_scales(const std::function<double(double)>& error_at, std::vector<ScaleTrial>& curve);
+
+}  // namespace hnn::nn::sampled
