@@ -211,21 +211,20 @@ Trial sampled_layers(const FitRequest& q, std::mt19937_64& rng, SampledFitReport
     report.swim_scale = reads_swim_scale(q.sampler, q.mc.activation) ? scale : 0;
     return sample_trial(q, scale, false, rng, report);
   }
-  std::optional<Trial> best;
-  std::mt19937_64 after = rng;
+  Trial last, best;
+  std::mt19937_64 draws = rng, after = rng;
   const auto error_at = [&](double scale) {
-    std::mt19937_64 draws = rng;
-    Trial t = sample_trial(q, scale, true, draws, report);
-    const double error = t.error;
-    if (!best || error < best->error) {  // the walk's own rule: ties to the first tried
-      best = std::move(t);
-      after = draws;
-    }
-    return error;
+    draws = rng;
+    last = sample_trial(q, scale, true, draws, report);
+    return last.error;
   };
-  report.swim_scale = sampled::walk_scales(error_at, report.scale_validation);
+  const auto keep_last = [&] {
+    best = std::move(last);
+    after = draws;
+  };
+  report.swim_scale = sampled::walk_scales(error_at, keep_last, report.scale_validation);
   rng = after;
-  return std::move(*best);
+  return best;
 }
 
 Fitted fit_once(const FitRequest& q, std::mt19937_64& rng, SampledFitReport& report) {

@@ -16,12 +16,14 @@ std::vector<double> swim_scale_ladder() {
   return ladder;
 }
 
-double walk_scales(const std::function<double(double)>& error_at, std::vector<ScaleTrial>& curve) {
+double walk_scales(const std::function<double(double)>& error_at,
+                   const std::function<void()>& keep_last, std::vector<ScaleTrial>& curve) {
   const std::vector<double> ladder = swim_scale_ladder();
   const auto peer = std::size_t(-kLowestPower);
   curve.clear();
   std::size_t best = peer;
   double best_error = error_at(ladder[peer]);
+  keep_last();
   curve.push_back({ladder[peer], best_error});
   // One direction: step while the error falls; true if the first step improved.
   const auto walk = [&](int step) {
@@ -30,7 +32,8 @@ double walk_scales(const std::function<double(double)>& error_at, std::vector<Sc
          i += step) {
       const double error = error_at(ladder[std::size_t(i)]);
       curve.push_back({ladder[std::size_t(i)], error});
-      if (!(error < best_error)) break;
+      if (!(error * kScaleGain < best_error)) break;
+      keep_last();
       best = std::size_t(i);
       best_error = error;
       moved = true;

@@ -339,8 +339,10 @@ TEST(SampledFit, LsqrIterationsAllocateNothing) {
   auto allocations = [&](int iterations) {
     std::mt19937_64 rng(1);
     auto model = make_model<double>(model_config(ModelKind::kHnn, {60}), rng);
-    const SampledFitConfig fit{
-        .solver = LeastSquaresSolver::kLsqr, .tolerance = 0, .max_iterations = iterations};
+    const SampledFitConfig fit{.swim_scale = kPeerSwimScale,  // no walk: one fit
+                               .solver = LeastSquaresSolver::kLsqr,
+                               .tolerance = 0,
+                               .max_iterations = iterations};
     const long before = hnn::testing::allocation_count();
     const SampledFitReport report = fit_sampled(*model, train.x, train.dxdt, fit);
     EXPECT_EQ(report.iterations, iterations);

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <random>
 
@@ -35,26 +36,41 @@ TEST(SwimScale, LadderIsThePeersScaleTimesPowersOfTwo) {
   EXPECT_NE(std::ranges::find(ladder, kPeerSwimScale), ladder.end());
 }
 
-// Down from the peer's scale while the error falls, one step past the best; up instead when the
-// first step down does not help; a NaN error stops the walk like a worse one.
-TEST(SwimScale, WalkGoesDownhillFromThePeersScale) {
+// Down from the peer's scale while the error falls by kScaleGain a step, one step past the best;
+// up instead when the first step down does not; differences within kScaleGain (a noisy target's)
+// leave the peer's scale; a NaN error stops the walk like a worse one. keep_last is called for
+// each new best, so the last one kept is the scale returned.
+TEST(SwimScale, WalkGoesDownhillFromThePeersScaleWhileItGainsClearly) {
   std::vector<ScaleTrial> curve;
-  const auto bowl = [](int best) {
-    return [best](double scale) { return 1.0 + std::abs(power_of(scale) - best); };
+  double last = 0, kept = 0;
+  const auto walk = [&](const std::function<double(double)>& error) {
+    const double chosen = walk_scales(
+        [&](double scale) {
+          last = scale;
+          return error(scale);
+        },
+        [&] { kept = last; }, curve);
+    EXPECT_EQ(kept, chosen);
+    return power_of(chosen);
   };
-  EXPECT_EQ(power_of(walk_scales(bowl(-3), curve)), -3);
+  const auto bowl = [](int best, double base) {
+    return [=](double scale) { return std::pow(base, std::abs(power_of(scale) - best)); };
+  };
+  EXPECT_EQ(walk(bowl(-3, 10)), -3);
   EXPECT_EQ(powers_tried(curve), (std::vector<int>{0, -1, -2, -3, -4}));
-  EXPECT_EQ(power_of(walk_scales(bowl(1), curve)), 1);
+  EXPECT_EQ(walk(bowl(1, 10)), 1);
   EXPECT_EQ(powers_tried(curve), (std::vector<int>{0, -1, 1, 2}));
-  EXPECT_EQ(power_of(walk_scales(bowl(-9), curve)), -5);  // the ladder's end
+  EXPECT_EQ(walk(bowl(-9, 10)), -5);  // the ladder's end
   EXPECT_EQ(powers_tried(curve), (std::vector<int>{0, -1, -2, -3, -4, -5}));
-  EXPECT_EQ(power_of(walk_scales(bowl(0), curve)), 0);
+  EXPECT_EQ(walk(bowl(0, 10)), 0);
+  EXPECT_EQ(powers_tried(curve), (std::vector<int>{0, -1, 1}));
+  EXPECT_EQ(walk(bowl(-3, 1.2)), 0);  // 20% a step: within the noise of a held-out error
   EXPECT_EQ(powers_tried(curve), (std::vector<int>{0, -1, 1}));
   const auto nan_below = [](double scale) {
-    return power_of(scale) < 0 ? std::numeric_limits<double>::quiet_NaN()
-                               : 1.0 / (1 + power_of(scale));
+    const int k = power_of(scale);
+    return k < 0 ? std::numeric_limits<double>::quiet_NaN() : std::pow(10.0, -k);
   };
-  EXPECT_EQ(power_of(walk_scales(nan_below, curve)), 2);
+  EXPECT_EQ(walk(nan_below), 2);
   EXPECT_EQ(powers_tried(curve), (std::vector<int>{0, -1, 1, 2}));
 }
 
