@@ -58,6 +58,11 @@ class Models(unittest.TestCase):
         tuned = hnn.HNN(2, hidden=(100,), seed=0).fit(x, dxdt, fit="sampled+adam", steps=3,
                                                        lr=1e-6, sampler="elm", solver="qr")
         self.assertEqual(tuned.shape, (3,))
+        # A given SWIM scale reaches the solve: another scale, another fit.
+        steep, smooth = (hnn.HNN(2, hidden=(100,), seed=0).fit(x, dxdt, fit="sampled", seed=1,
+                                                               swim_scale=s)[0]
+                         for s in (0.549, 0.05))
+        self.assertNotEqual(steep, smooth)
 
     def test_fit_is_seeded_and_batched(self):
         x, dxdt = spring_data()
@@ -300,6 +305,8 @@ class Errors(unittest.TestCase):
                     fit="sampled", steps=3)
         self.expect("sampler applies to a sampled fit only", self.model.fit, x, dxdt,
                     sampler="elm")
+        self.expect("--swim-scale must be auto or a finite number > 0, got -1", self.model.fit,
+                    x, dxdt, fit="sampled", swim_scale=-1)
         self.expect("unknown fit method 'magic'", self.model.fit, x, dxdt, fit="magic")
         self.expect("does not fit an lnn", hnn.LNN(2, hidden=(4,)).fit, x, dxdt, fit="sampled")
         self.expect("loss='rollout' trains with fit='adam' only", self.model.fit, paths, t,
