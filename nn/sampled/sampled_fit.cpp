@@ -202,9 +202,9 @@ Trial sample_trial(const FitRequest& q, double scale, bool score, std::mt19937_6
   return t;
 }
 
-// The hidden layers at the configured SWIM scale, or with --swim-scale auto at the scale of the
-// smallest held-out error (scale_choice.h); every scale draws the same pairs, so only the scale
-// differs between them, and rng ends where the chosen one's draws left it.
+// The hidden layers at the configured SWIM scale, or with --swim-scale auto at the scale the walk
+// keeps (scale_choice.h); every scale draws the same pairs, so only the scale differs between
+// them, and rng ends where the kept one's draws left it. At most two trials are held at once.
 Trial sampled_layers(const FitRequest& q, std::mt19937_64& rng, SampledFitReport& report) {
   if (!reads_swim_scale(q.sampler, q.mc.activation) || q.config.swim_scale) {
     const double scale = q.config.swim_scale.value_or(kPeerSwimScale);
@@ -215,6 +215,7 @@ Trial sampled_layers(const FitRequest& q, std::mt19937_64& rng, SampledFitReport
   std::mt19937_64 draws = rng, after = rng;
   const auto error_at = [&](double scale) {
     draws = rng;
+    last = Trial{};  // freed before the next is built: a baseline's holds N x width outputs
     last = sample_trial(q, scale, true, draws, report);
     return last.error;
   };
@@ -301,14 +302,9 @@ SampledFitReport fit_sampled(DynamicsModel<T>& model, const Matrix<double>& x,
     for (Index& w : first.hidden)
       w = std::max<Index>(1, Index(std::lround(double(w) * config.aswim_first_fraction)));
   }
-  const FitRequest first_request{first,
-                                 xc,
-                                 dc,
-                                 config,
-                                 adaptive ? HiddenSampler::kUswim : config.sampler,
-                                 nullptr,
-                                 baseline || adaptive};
-  Fitted fit = fit_once(first_request, rng, report);
+  const HiddenSampler first_sampler = adaptive ? HiddenSampler::kUswim : config.sampler;
+  Fitted fit =
+      fit_once({first, xc, dc, config, first_sampler, nullptr, baseline || adaptive}, rng, report);
   if (adaptive) {
     const ColMat approximate = fitted_outputs(fit);
     fit =
