@@ -103,7 +103,8 @@ const TrainOption kMethodOptions[] = {
              "pre-activation runs from -s to +s between its two data points, s a number > 0 (the "
              "peer's atanh(1/2) = 0.549; smaller, smoother neurons), or auto: the scale of "
              "0.549 * 2^k (k = -5 ... 2), walked from 0.549 while the field error on a held-out "
-             "tenth of the points falls, then refitted on all (default auto)",
+             "tenth of the points falls at least 1.5-fold a step, then refitted on all (default "
+             "auto)",
      .group = kFitGroup,
      .sweep_rank = 38,
      .applies_to = AppliesTo::kFieldTasks,
