@@ -161,9 +161,8 @@ int main(int argc, char** argv) try {
       "\"fit_seconds\": {:.2f}, \"sample_seconds\": {:.2f}, \"assemble_seconds\": {:.2f}, "
       "\"gram_seconds\": {:.2f}, \"solve_seconds\": {:.2f}, \"iterations\": {}, \"rows\": {}, "
       "\"columns\": {}, \"matrix_gb\": {:.2f}, \"peak_rss_gb\": {:.2f}, \"gram_gflops\": {:.1f}, "
-      "\"residual_rms\": {:.3e}, \"rcond\": {:g}, \"validation_seconds\": {:.2f}, \"swim_scale\": "
-      "{:.4g}, "
-      "\"wall_seconds\": {:.2f}}}\n",
+      "\"residual_rms\": {:.3e}, \"rcond\": {:g}, \"validation_seconds\": {:.2f}, "
+      "\"swim_scale\": {:.4g}, \"wall_seconds\": {:.2f}}}\n",
       arg(argc, argv, "system", "hh"), nn::name_of(nn::kHiddenSamplerNames, fit.sampler), r.solver,
       width, layers, train, shifted, pinned,
       r.sample_seconds + r.assemble_seconds + r.solve_seconds, r.sample_seconds, r.assemble_seconds,

@@ -92,6 +92,18 @@ std::vector<PointSplit> validation_folds(Index points) {
 
 namespace {
 
+// |system's A c - B|², with `fitted` as the buffer for A c.
+double squared_residual(const LinearSystem& system, const ColMat& c, ColMat& fitted) {
+  fitted.resize(system.equations(), system.rhs_columns());
+  system.apply(c, fitted);
+  return (fitted - system.rhs()).squaredNorm();
+}
+
+// A summed squared residual relative to the summed squared targets.
+double relative_error(double squared, double target) {
+  return std::sqrt(squared / (target > 0 ? target : 1.0));
+}
+
 // One fold: its training points' reduced problem, and the system of its held-out points.
 struct Fold {
   ColMat a, b;
@@ -101,13 +113,9 @@ struct Fold {
   Fold(const SystemOn& system_on, const PointSplit& split) {
     system_on(split.train)->reduced(a, b);  // the training system goes before the held-out's
     held_out = system_on(split.held_out);
-    fitted.resize(held_out->equations(), held_out->rhs_columns());
   }
   // The squared held-out residual of the last layer c.
-  double error_of(const ColMat& c) {
-    held_out->apply(c, fitted);
-    return (fitted - held_out->rhs()).squaredNorm();
-  }
+  double error_of(const ColMat& c) { return squared_residual(*held_out, c, fitted); }
 };
 
 // qr: one SVD of the fold's reduced problem, each cutoff a truncated product with its factors.
@@ -223,7 +231,7 @@ double choose_rcond(const SystemOn& system_on, const std::vector<PointSplit>& fo
   curve.clear();
   for (std::size_t i = 0; i < ladder.size(); ++i) {
     if (!std::isfinite(squared[i])) continue;  // a cutoff ridge's walk did not reach
-    const double error = std::sqrt(squared[i] / (target > 0 ? target : 1.0));
+    const double error = relative_error(squared[i], target);
     curve.push_back({ladder[i], error, ranks[i]});
     if (error < best) {
       best = error;
@@ -239,12 +247,11 @@ double held_out_error(const SystemOn& system_on, const std::vector<PointSplit>& 
   for (const PointSplit& split : folds) {
     const ColMat c = solve_least_squares(*system_on(split.train), config).c;
     const std::unique_ptr<LinearSystem> held_out = system_on(split.held_out);
-    ColMat fitted(held_out->equations(), held_out->rhs_columns());
-    held_out->apply(c, fitted);
-    squared += (fitted - held_out->rhs()).squaredNorm();
+    ColMat fitted;
+    squared += squared_residual(*held_out, c, fitted);
     target += held_out->rhs().squaredNorm();
   }
-  return std::sqrt(squared / (target > 0 ? target : 1.0));
+  return relative_error(squared, target);
 }
 
 }  // namespace hnn::nn::sampled

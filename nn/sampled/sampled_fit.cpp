@@ -206,9 +206,10 @@ Trial sample_trial(const FitRequest& q, double scale, bool score, std::mt19937_6
 // keeps (scale_choice.h); every scale draws the same pairs, so only the scale differs between
 // them, and rng ends where the kept one's draws left it. At most two trials are held at once.
 Trial sampled_layers(const FitRequest& q, std::mt19937_64& rng, SampledFitReport& report) {
-  if (!reads_swim_scale(q.sampler, q.mc.activation) || q.config.swim_scale) {
+  const bool reads = reads_swim_scale(q.sampler, q.mc.activation);
+  if (!reads || q.config.swim_scale) {
     const double scale = q.config.swim_scale.value_or(kPeerSwimScale);
-    report.swim_scale = reads_swim_scale(q.sampler, q.mc.activation) ? scale : 0;
+    report.swim_scale = reads ? scale : 0;
     return sample_trial(q, scale, false, rng, report);
   }
   Trial last, best;

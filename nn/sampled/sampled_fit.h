@@ -64,7 +64,7 @@ struct SampledFitConfig {
   /// SWIM: a neuron's pre-activation runs from -swim_scale to +swim_scale between its two data
   /// points (the peer's kPeerSwimScale); smaller, smoother neurons. Empty (auto, the default):
   /// chosen by validation like rcond, walking kPeerSwimScale * 2^k from k = 0 while the held-out
-  /// error falls (scale_choice.h). ELM does not read it.
+  /// error falls kScaleGain-fold a step (scale_choice.h). ELM does not read it.
   std::optional<double> swim_scale{};
   /// kQr, kRidge: singular values below rcond times the largest do not shape the solution (the
   /// peer's np.linalg.lstsq rcond; kQr drops them, kRidge damps them). Empty (auto, the default):

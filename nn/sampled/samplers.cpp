@@ -93,12 +93,11 @@ HiddenLayer sample_layer(const ColMat& u, Index width, HiddenSampler sampler, Ac
         "points; lower the width or give more data",
         width, usable, n));
   }
-  // tanh maps u_from to -s and u_to to +s (the peer's s = atanh(1/2)); sigmoid the same points of
-  // its own curve; the relu family maps them to 0 and 1.
-  const double s = scale;
+  // tanh maps u_from to -scale and u_to to +scale (the peer's atanh(1/2)); sigmoid the same points
+  // of its own curve; the relu family maps them to 0 and 1.
   double gain = 1, shift = 0;
-  if (activation == Activation::kTanh) gain = 2 * s, shift = -s;
-  if (activation == Activation::kSigmoid) gain = 4 * s, shift = -2 * s;
+  if (activation == Activation::kTanh) gain = 2 * scale, shift = -scale;
+  if (activation == Activation::kSigmoid) gain = 4 * scale, shift = -2 * scale;
   HiddenLayer layer{ColMat(u.cols(), width), Eigen::RowVectorXd(width)};
   const std::vector<Index> chosen = draw_distinct(std::move(p), width, rng);
   for (Index j = 0; j < width; ++j) {

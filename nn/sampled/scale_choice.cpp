@@ -25,9 +25,8 @@ double walk_scales(const std::function<double(double)>& error_at,
   double best_error = error_at(ladder[peer]);
   keep_last();
   curve.push_back({ladder[peer], best_error});
-  // One direction: step while the error falls; true if the first step improved.
+  // One direction: step while the error falls kScaleGain-fold.
   const auto walk = [&](int step) {
-    bool moved = false;
     for (auto i = std::ptrdiff_t(peer) + step; i >= 0 && i < std::ptrdiff_t(ladder.size());
          i += step) {
       const double error = error_at(ladder[std::size_t(i)]);
@@ -36,11 +35,10 @@ double walk_scales(const std::function<double(double)>& error_at,
       keep_last();
       best = std::size_t(i);
       best_error = error;
-      moved = true;
     }
-    return moved;
   };
-  if (!walk(-1)) walk(+1);
+  walk(-1);
+  if (best == peer) walk(+1);  // the first halving did not gain enough
   return ladder[best];
 }
 

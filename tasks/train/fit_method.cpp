@@ -18,26 +18,32 @@ void check_fraction(double value, const std::string& key, const std::string& tas
                   fit_option_name(key), value);
 }
 
-// "rcond": "auto" (chosen by validation, nn/sampled/rcond_choice.h; also when absent) or a
-// number in (0, 1).
-std::optional<double> rcond_setting(const json& s, const std::string& task) {
-  const auto it = s.find("rcond");
+// The number under `key`, or empty for "auto" or no such key; a value of another type is
+// refused as "--KEY must be auto or WHAT".
+std::optional<double> auto_or_number(const json& s, const std::string& key, const char* what,
+                                     const std::string& task) {
+  const auto it = s.find(key);
   if (it == s.end() || *it == "auto") return std::nullopt;
-  HNN_TASKS_CHECK(it->is_number(), "{}: --rcond must be auto or a number in (0, 1), got {}", task,
-                  it->dump());
-  const double rcond = it->get<double>();
-  check_fraction(rcond, "rcond", task);
+  HNN_TASKS_CHECK(it->is_number(), "{}: --{} must be auto or {}, got {}", task,
+                  fit_option_name(key), what, it->dump());
+  return it->get<double>();
+}
+
+// "rcond": auto (chosen by validation, nn/sampled/rcond_choice.h) or a number in (0, 1).
+std::optional<double> rcond_setting(const json& s, const std::string& task) {
+  const std::optional<double> rcond = auto_or_number(s, "rcond", "a number in (0, 1)", task);
+  if (rcond) check_fraction(*rcond, "rcond", task);
   return rcond;
 }
 
-// "swim_scale": "auto" (chosen by validation, nn/sampled/scale_choice.h; also when absent) or a
-// finite number > 0.
+// "swim_scale": auto (chosen by validation, nn/sampled/scale_choice.h) or a finite number > 0.
 std::optional<double> swim_scale_setting(const json& s, const std::string& task) {
-  const auto it = s.find("swim_scale");
-  if (it == s.end() || *it == "auto") return std::nullopt;
-  HNN_TASKS_CHECK(it->is_number() && std::isfinite(it->get<double>()) && it->get<double>() > 0,
-                  "{}: --swim-scale must be auto or a finite number > 0, got {}", task, it->dump());
-  return it->get<double>();
+  constexpr const char* kWhat = "a finite number > 0";
+  const std::optional<double> scale = auto_or_number(s, "swim_scale", kWhat, task);
+  HNN_TASKS_CHECK(!scale || (std::isfinite(*scale) && *scale > 0),
+                  "{}: --swim-scale must be auto or {}, got {}", task, kWhat,
+                  s.at("swim_scale").dump());
+  return scale;
 }
 
 }  // namespace

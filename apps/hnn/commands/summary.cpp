@@ -55,22 +55,27 @@ std::string heading_line(const json& m) {
                      text_at(m, "seed"), fit_words(m), text_at(m, "hidden"), text_at(m, "dtype"));
 }
 
+// The held-out error of the trial of `curve` whose `key` is `chosen` (NaN if none).
+double chosen_error(const json& curve, const char* key, double chosen) {
+  for (const json& trial : curve)
+    if (number_at(trial, key) == chosen) return number_at(trial, "error").value_or(NAN);
+  return NAN;
+}
+
 // "  rcond      auto chose 1e-03 in 0.01 s (held-out field error 3.77e-02; 5.39e-02 at 1e-14,
 // 0.263 at 1e-01)", for --rcond auto; "" otherwise.
 std::string rcond_line(const json& fit) {
   const auto curve = fit.find("rcond_validation");
   if (curve == fit.end() || !curve->is_array() || curve->empty()) return "";
   const auto error_at = [&](const json& trial) { return number_at(trial, "error").value_or(NAN); };
-  double chosen_error = NAN;
   const double chosen = number_at(fit, "rcond_used").value_or(NAN);
-  for (const json& trial : *curve)
-    if (number_at(trial, "rcond") == chosen) chosen_error = error_at(trial);
   return fmt::format(
       "  rcond      auto chose {:.0e} in {:.3g} s (held-out field error {:.3g}; {:.3g} at {:.0e}, "
       "{:.3g} at {:.0e})\n",
-      chosen, number_at(fit, "validation_seconds").value_or(NAN), chosen_error,
-      error_at(curve->front()), number_at(curve->front(), "rcond").value_or(NAN),
-      error_at(curve->back()), number_at(curve->back(), "rcond").value_or(NAN));
+      chosen, number_at(fit, "validation_seconds").value_or(NAN),
+      chosen_error(*curve, "rcond", chosen), error_at(curve->front()),
+      number_at(curve->front(), "rcond").value_or(NAN), error_at(curve->back()),
+      number_at(curve->back(), "rcond").value_or(NAN));
 }
 
 // "  swim scale auto chose 0.0343 (held-out field error 2.1e-10; 1.6e-06 at 0.549)", for
@@ -79,12 +84,9 @@ std::string swim_scale_line(const json& fit) {
   const auto curve = fit.find("swim_scale_validation");
   if (curve == fit.end() || !curve->is_array() || curve->empty()) return "";
   const double chosen = number_at(fit, "swim_scale_used").value_or(NAN);
-  double chosen_error = NAN;
-  for (const json& trial : *curve)
-    if (number_at(trial, "scale") == chosen) chosen_error = number_at(trial, "error").value_or(NAN);
   return fmt::format(
       "  swim scale auto chose {:.3g} (held-out field error {:.3g}; {:.3g} at {:.3g})\n", chosen,
-      chosen_error, number_at(curve->front(), "error").value_or(NAN),
+      chosen_error(*curve, "scale", chosen), number_at(curve->front(), "error").value_or(NAN),
       number_at(curve->front(), "scale").value_or(NAN));
 }
 

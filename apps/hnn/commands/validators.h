@@ -62,29 +62,25 @@ inline CLI::Validator positive_real() {
       "POSITIVE");
 }
 
-/// "auto", or a number in (0, 1) (--rcond).
-inline CLI::Validator auto_or_fraction() {
+/// "auto", or a number that `accepts` takes, described as `what` in the message.
+inline CLI::Validator auto_or(bool (*accepts)(double), const std::string& what) {
   return CLI::Validator(
-      [](std::string& text) -> std::string {
+      [accepts, what](std::string& text) -> std::string {
         double value = 0;
-        if (text == "auto" || (detail::parse_whole(text, value) && value > 0 && value < 1))
-          return "";
-        return "expected auto or a number in (0, 1), got '" + text + "'";
+        if (text == "auto" || (detail::parse_whole(text, value) && accepts(value))) return "";
+        return "expected auto or " + what + ", got '" + text + "'";
       },
       "AUTO|X");
 }
 
+/// "auto", or a number in (0, 1) (--rcond).
+inline CLI::Validator auto_or_fraction() {
+  return auto_or([](double v) { return v > 0 && v < 1; }, "a number in (0, 1)");
+}
+
 /// "auto", or a finite number > 0 (--swim-scale).
 inline CLI::Validator auto_or_positive() {
-  return CLI::Validator(
-      [](std::string& text) -> std::string {
-        double value = 0;
-        if (text == "auto" ||
-            (detail::parse_whole(text, value) && std::isfinite(value) && value > 0))
-          return "";
-        return "expected auto or a finite number > 0, got '" + text + "'";
-      },
-      "AUTO|X");
+  return auto_or([](double v) { return std::isfinite(v) && v > 0; }, "a finite number > 0");
 }
 
 }  // namespace hnn::app

@@ -88,6 +88,22 @@ std::string folder_safe(const std::string& text) {
   return s.empty() ? "-" : s;
 }
 
+// A number kind: which numbers it takes, and how its messages say so.
+struct NumberRange {
+  bool (*accepts)(double);
+  const char* what;
+};
+constexpr NumberRange kPositiveRange{[](double x) { return std::isfinite(x) && x > 0; },
+                                     "a finite number > 0"};
+constexpr NumberRange kFractionRange{[](double x) { return x > 0 && x < 1; }, "a number in (0, 1)"};
+
+// v when it is a number in `range` (or "auto", where allowed); else what was expected.
+ordered_json checked_number(const ordered_json& v, bool allow_auto, NumberRange range) {
+  if ((allow_auto && v == "auto") || (v.is_number() && range.accepts(v.get<double>()))) return v;
+  throw std::invalid_argument(
+      fmt::format("expected {}{}, got {}", allow_auto ? "\"auto\" or " : "", range.what, v.dump()));
+}
+
 }  // namespace
 
 // The value in its canonical form (hidden as a list, a file as an absolute path, ...), or
@@ -119,20 +135,13 @@ ordered_json checked_value(const TrainOption& key, const ordered_json& v) {
       return widths;
     }
     case ValueKind::kPositiveReal:
-      if (v.is_number() && std::isfinite(v.get<double>()) && v.get<double>() > 0) return v;
-      throw std::invalid_argument(fmt::format("expected a finite number > 0, got {}", v.dump()));
+      return checked_number(v, false, kPositiveRange);
     case ValueKind::kFraction:
-      if (v.is_number() && v.get<double>() > 0 && v.get<double>() < 1) return v;
-      throw std::invalid_argument(fmt::format("expected a number in (0, 1), got {}", v.dump()));
+      return checked_number(v, false, kFractionRange);
     case ValueKind::kAutoOrFraction:
-      if (v == "auto" || (v.is_number() && v.get<double>() > 0 && v.get<double>() < 1)) return v;
-      throw std::invalid_argument(
-          fmt::format("expected \"auto\" or a number in (0, 1), got {}", v.dump()));
+      return checked_number(v, true, kFractionRange);
     case ValueKind::kAutoOrPositive:
-      if (v == "auto" || (v.is_number() && std::isfinite(v.get<double>()) && v.get<double>() > 0))
-        return v;
-      throw std::invalid_argument(
-          fmt::format("expected \"auto\" or a finite number > 0, got {}", v.dump()));
+      return checked_number(v, true, kPositiveRange);
     case ValueKind::kFile:
       if (v.is_string() && !v.get<std::string>().empty())
         return fs::absolute(v.get<std::string>()).lexically_normal().string();
