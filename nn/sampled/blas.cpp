@@ -31,8 +31,10 @@ void dtpmqrt_(const char* side, const char* trans, const int* m, const int* n, c
 
 namespace hnn::nn::sampled {
 
-BlasThreads::BlasThreads() { openblas_set_num_threads(ad::num_threads()); }
-BlasThreads::~BlasThreads() { openblas_set_num_threads(1); }
+BlasThreads::BlasThreads(int threads) : previous_(openblas_get_num_threads()) {
+  openblas_set_num_threads(threads > 0 ? threads : ad::num_threads());
+}
+BlasThreads::~BlasThreads() { openblas_set_num_threads(previous_); }
 
 void blas_gemm(const ColMat& a, bool ta, const ColMat& b, bool tb, ColMat& c, double beta) {
   const auto m = int(c.rows()), n = int(c.cols());
@@ -96,6 +98,11 @@ void qr_merge_triangle(ColMat& r, ColMat& t, ColMat& c, ColMat& d) {
 }
 
 void solve_upper(const ColMat& r, bool transpose, ColMat& y) {
+  if (y.cols() == 1) {  // dtrsv: dtrsm packs the triangle first, twice the time for one column
+    cblas_dtrsv(CblasColMajor, CblasUpper, transpose ? CblasTrans : CblasNoTrans, CblasNonUnit,
+                int(r.rows()), r.data(), int(r.rows()), y.data(), 1);
+    return;
+  }
   cblas_dtrsm(CblasColMajor, CblasLeft, CblasUpper, transpose ? CblasTrans : CblasNoTrans,
               CblasNonUnit, int(y.rows()), int(y.cols()), 1.0, r.data(), int(r.rows()), y.data(),
               int(y.rows()));
@@ -141,7 +148,7 @@ void reduce_to_triangle(ColMat& a, ColMat& b) {
   b.conservativeResize(a.cols(), Eigen::NoChange);
 }
 
-double largest_singular_value(const ColMat& r, int iterations) {
+double largest_singular_value(const ColMat& r, int iterations, Eigen::VectorXd* vector) {
   const auto upper = r.triangularView<Eigen::Upper>();
   Eigen::VectorXd v = Eigen::VectorXd::Ones(r.cols()), u;
   double sigma = 0;
@@ -151,6 +158,7 @@ double largest_singular_value(const ColMat& r, int iterations) {
     v.noalias() = upper.transpose() * u;
     sigma = std::sqrt(v.norm());
   }
+  if (vector != nullptr) *vector = v.norm() > 0 ? Eigen::VectorXd(v.normalized()) : v;
   return sigma;
 }
 

@@ -8,15 +8,20 @@ namespace hnn::nn::sampled {
 
 using ColMat = Eigen::MatrixXd;
 
-/// OpenBLAS uses ad::num_threads() threads while this lives, then one again: the engine calls
-/// OpenBLAS's serial GEMM from its own threads (autodiff/gemm.cpp), but the fit's big products
-/// run alone and are worth both cores.
+/// OpenBLAS uses `threads` threads (ad::num_threads() by default) while this lives, then as many
+/// as before: the engine calls OpenBLAS's serial GEMM from its own threads (autodiff/gemm.cpp),
+/// but the fit's big products run alone and are worth both cores. LSQR's iterations ask for 1:
+/// there the engine's threads stream D, and OpenBLAS's idle workers, which spin in sched_yield
+/// after each call, would take their cores.
 class BlasThreads {
  public:
-  BlasThreads();
+  explicit BlasThreads(int threads = 0);  // 0: ad::num_threads()
   ~BlasThreads();
   BlasThreads(const BlasThreads&) = delete;
   BlasThreads& operator=(const BlasThreads&) = delete;
+
+ private:
+  int previous_;
 };
 
 /// c = op(a) op(b) + beta c (op: transpose when the flag is set); c must have the right size.
@@ -46,8 +51,9 @@ int lstsq_svd(ColMat& a, ColMat& b, double rcond);
 void ridge_triangle(ColMat& r, ColMat& b, double mu);
 /// The largest singular value of an upper-triangular r, from `iterations` power steps on r^T r
 /// (an estimate from below, matrix-vector products only: enough to place a cutoff a decade
-/// apart from the next).
-double largest_singular_value(const ColMat& r, int iterations = 20);
+/// apart from the next), and in `vector` the last step's unit vector when given.
+double largest_singular_value(const ColMat& r, int iterations = 20,
+                              Eigen::VectorXd* vector = nullptr);
 /// a <- its QR's triangle (a.cols() square) and b <- the first a.cols() rows of Q^T b, unless a
 /// is upper triangular and square already (the Hadamard form's merged reduction).
 void reduce_to_triangle(ColMat& a, ColMat& b);

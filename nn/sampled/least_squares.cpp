@@ -8,6 +8,9 @@
 #include <limits>
 #include <stdexcept>
 
+#include "nn/sampled/lsqr.h"
+#include "nn/sampled/sketch.h"
+
 namespace hnn::nn::sampled {
 
 using Eigen::Index;
@@ -19,23 +22,6 @@ using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
-
-// The right preconditioner c = S R^-1 y: R upper triangular, S a column scaling.
-struct Preconditioner {
-  ColMat r;
-  Eigen::VectorXd s;
-
-  void apply(const ColMat& y, ColMat& c) const {  // c = S R^-1 y, in c's own memory
-    c = y;
-    solve_upper(r, false, c);
-    c.array().colwise() *= s.array();
-  }
-  void apply_t(const ColMat& c, ColMat& y) const {  // y = R^-T S c
-    y = c;
-    y.array().colwise() *= s.array();
-    solve_upper(r, true, y);
-  }
-};
 
 // A column of A that is zero (a neuron whose input gradient vanishes at every data point)
 // leaves its unknown without an equation: the system is singular, whatever the solver.
@@ -78,75 +64,6 @@ Preconditioner cholesky_preconditioner(const ColMat& gram, double regularization
                   largest));
 }
 
-// LSQR (Paige & Saunders 1982) on A M (M the preconditioner), started from c: it solves for the
-// correction, and returns the iterations.
-struct Lsqr {
-  const LinearSystem& a;
-  const Preconditioner& m;
-  ColMat u, v, w, x, av, atu;
-
-  ColMat c_space;  // a vector of unknowns (M's output)
-
-  Lsqr(const LinearSystem& system, const Preconditioner& preconditioner)
-      : a(system),
-        m(preconditioner),
-        u(system.equations(), system.rhs_columns()),
-        v(preconditioner.r.rows(), system.rhs_columns()),
-        w(v),
-        x(v),
-        av(u),
-        atu(v),
-        c_space(system.unknowns(), system.rhs_columns()) {}
-
-  void forward(const ColMat& y, ColMat& out) {  // out = A M y
-    m.apply(y, c_space);
-    a.apply(c_space, out);
-  }
-  void backward(const ColMat& r, ColMat& out) {  // out = M^T A^T r
-    a.apply_t(r, c_space);
-    m.apply_t(c_space, out);
-  }
-
-  int run(ColMat& c, double tolerance, int max_iterations) {
-    a.apply(c, u);
-    u = a.rhs() - u;
-    double beta = u.norm();
-    if (beta == 0) return 0;
-    u /= beta;
-    backward(u, v);
-    double alpha = v.norm();
-    if (alpha == 0) return 0;
-    v /= alpha;
-    w = v;
-    x.setZero();
-    double phibar = beta, rhobar = alpha, anorm2 = 0;
-    int it = 0;
-    while (it < max_iterations) {
-      ++it;
-      forward(v, av);
-      u = av - alpha * u;
-      beta = u.norm();
-      if (beta > 0) u /= beta;
-      anorm2 += alpha * alpha + beta * beta;
-      backward(u, atu);
-      v = atu - beta * v;
-      alpha = v.norm();
-      if (alpha > 0) v /= alpha;
-      const double rho = std::hypot(rhobar, beta), cs = rhobar / rho, sn = beta / rho;
-      const double theta = sn * alpha, phi = cs * phibar;
-      rhobar = -cs * alpha;
-      phibar = sn * phibar;
-      x += (phi / rho) * w;
-      w = v - (theta / rho) * w;
-      // |(A M)^T r| = phibar alpha |cs| against |A M| |r| (Paige & Saunders' test 2).
-      if (alpha * std::abs(cs) <= tolerance * std::sqrt(anorm2) || alpha == 0) break;
-    }
-    m.apply(x, c_space);
-    c += c_space;
-    return it;
-  }
-};
-
 void check_finite(const ColMat& c) {
   if (!c.allFinite()) {
     throw std::invalid_argument(
@@ -181,6 +98,21 @@ void solve_reduced(const LinearSystem& system, LeastSquaresSolver solver, double
   out.solve_seconds = seconds_since(start);
 }
 
+// sketch: the sketch's reduction is its assembly, the damped merge and LSQR its solve.
+void solve_sketched(const LinearSystem& system, const SampledFitConfig& config,
+                    LeastSquaresResult& out) {
+  auto start = Clock::now();
+  const SketchedRidge sketch(system, sketch_seed(config.seed));
+  out.gram_seconds = seconds_since(start);
+  start = Clock::now();
+  SketchedRidge::Solution solved =
+      sketch.solve(config.rcond.value(), config.tolerance, config.max_iterations);
+  out.c.swap(solved.c);
+  out.iterations = solved.iterations;
+  out.bytes = solved.bytes;
+  out.solve_seconds = seconds_since(start);
+}
+
 }  // namespace
 
 LeastSquaresResult solve_least_squares(const LinearSystem& system, const SampledFitConfig& config,
@@ -188,8 +120,10 @@ LeastSquaresResult solve_least_squares(const LinearSystem& system, const Sampled
   const BlasThreads threads;
   LeastSquaresResult out;
   const Index p = system.unknowns();
-  if (config.solver != LeastSquaresSolver::kLsqr &&
-      config.solver != LeastSquaresSolver::kCholesky) {
+  if (config.solver == LeastSquaresSolver::kSketch) {
+    solve_sketched(system, config, out);
+  } else if (config.solver != LeastSquaresSolver::kLsqr &&
+             config.solver != LeastSquaresSolver::kCholesky) {
     solve_reduced(system, config.solver, config.rcond.value(), reduced, out);
   } else {
     auto start = Clock::now();
@@ -209,7 +143,7 @@ LeastSquaresResult solve_least_squares(const LinearSystem& system, const Sampled
     check_finite(out.c);
     if (config.solver == LeastSquaresSolver::kLsqr) {
       Lsqr lsqr(system, m);
-      out.bytes += std::size_t(lsqr.u.size() * 2 + lsqr.v.size() * 4) * sizeof(double);
+      out.bytes += lsqr.bytes();
       out.iterations = lsqr.run(out.c, config.tolerance, config.max_iterations);
     }
     out.solve_seconds = seconds_since(start);

@@ -5,7 +5,10 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <stdexcept>
+
+#include "nn/sampled/sketch.h"
 
 // LAPACK's divide-and-conquer SVD (OpenBLAS carries it; see nn/sampled/blas.cpp).
 extern "C" {
@@ -104,14 +107,22 @@ double relative_error(double squared, double target) {
   return std::sqrt(squared / (target > 0 ? target : 1.0));
 }
 
-// One fold: its training points' reduced problem, and the system of its held-out points.
+// One fold: its training points' reduced problem (qr, ridge) or sketch (sketch, which keeps
+// their system: its LSQR reads it), and the system of its held-out points.
 struct Fold {
   ColMat a, b;
-  std::unique_ptr<LinearSystem> held_out;
+  std::unique_ptr<LinearSystem> train, held_out;
+  std::optional<SketchedRidge> sketch;
   ColMat fitted;
 
-  Fold(const SystemOn& system_on, const PointSplit& split) {
-    system_on(split.train)->reduced(a, b);  // the training system goes before the held-out's
+  Fold(const SystemOn& system_on, const PointSplit& split, const SampledFitConfig& config) {
+    train = system_on(split.train);
+    if (config.solver == LeastSquaresSolver::kSketch) {
+      sketch.emplace(*train, sketch_seed(config.seed));
+    } else {
+      train->reduced(a, b);
+      train.reset();  // the training system goes before the held-out's
+    }
     held_out = system_on(split.held_out);
   }
   // The squared held-out residual of the last layer c.
@@ -142,30 +153,37 @@ void svd_rungs(Fold& fold, const std::vector<double>& ladder, std::vector<double
   }
 }
 
-// ridge: one Tikhonov solve of each fold's triangle per cutoff (a dtpqrt each, no SVD), walked
+// ridge and sketch damp rather than drop: every rank is the width. Each fold is solved once per
+// cutoff (ridge: a dtpqrt of its triangle, no SVD; sketch: its sketch's merge and LSQR), walked
 // from the smallest cutoff and stopped once the held-out error, summed over the folds, passes
 // kRidgeStop times the best so far: on exact derivatives it rises tenfold a cutoff from the
 // smallest (after three or four cutoffs), on noisy ones it wanders within a few times the best
 // and falls to a large cutoff (a stop two cutoffs after the best chose 1e-12 on the pendulum
-// task, whose best is 1e-4). The cutoffs not reached count as infinitely bad. Ridge damps
-// rather than drops: every rank is the width.
+// task, whose best is 1e-4). The cutoffs not reached count as infinitely bad.
 constexpr double kRidgeStop = 100;
 
-void ridge_walk(std::vector<Fold>& folds, const std::vector<double>& ladder,
-                std::vector<double>& squared, std::vector<int>& ranks) {
-  std::vector<double> largest;
-  for (Fold& fold : folds) {
-    reduce_to_triangle(fold.a, fold.b);
-    largest.push_back(largest_singular_value(fold.a));
+void damped_walk(std::vector<Fold>& folds, const SampledFitConfig& config,
+                 const std::vector<double>& ladder, std::vector<double>& squared,
+                 std::vector<int>& ranks) {
+  std::vector<double> largest(folds.size(), 0.0);
+  for (std::size_t f = 0; f < folds.size(); ++f) {
+    if (folds[f].sketch) continue;
+    reduce_to_triangle(folds[f].a, folds[f].b);
+    largest[f] = largest_singular_value(folds[f].a);
   }
+  const auto solve_at = [&](std::size_t f, double rcond) {
+    Fold& fold = folds[f];
+    if (fold.sketch) return fold.sketch->solve(rcond, config.tolerance, config.max_iterations).c;
+    ColMat r = fold.a, c = fold.b;
+    ridge_triangle(r, c, rcond * largest[f]);
+    return c;
+  };
   double best = std::numeric_limits<double>::infinity();
   std::size_t i = 0;
   while (i < ladder.size()) {
     for (std::size_t f = 0; f < folds.size(); ++f) {
-      ColMat r = folds[f].a, c = folds[f].b;
-      ridge_triangle(r, c, ladder[i] * largest[f]);
-      squared[i] += folds[f].error_of(c);
-      ranks[i] = int(r.cols());
+      squared[i] += folds[f].error_of(solve_at(f, ladder[i]));
+      ranks[i] = int(folds[f].held_out->unknowns());
     }
     best = std::min(best, squared[i]);
     // squared errors: the stop's factor squared
@@ -195,24 +213,30 @@ void merge_halves(Fold& fold, ReducedProblem& whole) {
 }  // namespace
 
 double choose_rcond(const SystemOn& system_on, const std::vector<PointSplit>& folds,
-                    LeastSquaresSolver solver, const std::vector<double>& ladder,
+                    const SampledFitConfig& config, const std::vector<double>& ladder,
                     std::vector<RcondTrial>& curve, ReducedProblem* whole) {
-  const bool merge = whole != nullptr && folds.size() == 1;
+  const bool damped =
+      config.solver == LeastSquaresSolver::kRidge || config.solver == LeastSquaresSolver::kSketch;
+  // sketch: the whole problem is sketched anew (merging the held-out points' reduction would cost
+  // the QR of D that the sketch avoids)
+  const bool merge =
+      whole != nullptr && folds.size() == 1 && config.solver != LeastSquaresSolver::kSketch;
   const BlasThreads threads;
   std::vector<double> squared(ladder.size(), 0.0);
   std::vector<int> ranks(ladder.size(), 0);
   double target = 0;
-  if (solver == LeastSquaresSolver::kRidge) {  // every fold at each cutoff, to stop early
+  if (damped) {  // every fold at each cutoff, to stop early
     std::vector<Fold> prepared;
+    prepared.reserve(folds.size());  // a sketch refers to its fold's training system
     for (const PointSplit& split : folds) {
-      prepared.emplace_back(system_on, split);
+      prepared.emplace_back(system_on, split, config);
       target += prepared.back().held_out->rhs().squaredNorm();
     }
-    ridge_walk(prepared, ladder, squared, ranks);  // leaves each fold's triangle in a, b
+    damped_walk(prepared, config, ladder, squared, ranks);  // ridge: each triangle left in a, b
     if (merge) merge_halves(prepared.front(), *whole);
   } else {  // a fold at a time: one SVD's factors held at once
     for (const PointSplit& split : folds) {
-      Fold fold(system_on, split);
+      Fold fold(system_on, split, config);
       target += fold.held_out->rhs().squaredNorm();
       if (merge) {
         reduce_to_triangle(fold.a, fold.b);

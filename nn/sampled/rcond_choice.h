@@ -40,15 +40,15 @@ std::vector<PointSplit> validation_folds(Eigen::Index points);
 /// Builds the last layer's system on the given points (indices into the fit's data).
 using SystemOn = std::function<std::unique_ptr<LinearSystem>(const std::vector<Eigen::Index>&)>;
 
-/// The cutoff of `ladder` (rcond_ladder(), or one given cutoff to score) whose fits by `solver`
-/// (qr or ridge) on each fold's training points have the smallest relative field error over the
-/// held-out points of every fold (ties to the smaller cutoff), and every cutoff's error in
-/// `curve` (ridge: those its walk reached).
-/// With one fold and `whole`, also the whole problem's triangle: the fold's training triangle
-/// merged with its held-out points' (one dtpqrt), which saves the fit at the chosen cutoff a
-/// reduction of all the points (qr_apply's 11 s of the Henon-Heiles protocol's fit).
+/// The cutoff of `ladder` (rcond_ladder(), or one given cutoff to score) whose fits by
+/// config.solver (qr or ridge) on each fold's training points have the smallest relative field
+/// error over the held-out points of every fold (ties to the smaller cutoff), and every cutoff's
+/// error in `curve` (ridge: those its walk reached). With one fold and `whole`, also the whole
+/// problem's triangle: the fold's training triangle merged with its held-out points' (one dtpqrt),
+/// which saves the fit at the chosen cutoff a reduction of all the points (qr_apply's 11 s of the
+/// Henon-Heiles protocol's fit).
 double choose_rcond(const SystemOn& system_on, const std::vector<PointSplit>& folds,
-                    LeastSquaresSolver solver, const std::vector<double>& ladder,
+                    const SampledFitConfig& config, const std::vector<double>& ladder,
                     std::vector<RcondTrial>& curve, ReducedProblem* whole = nullptr);
 
 /// The relative field error over the held-out points of every fold of fits by config.solver on

@@ -193,7 +193,7 @@ Trial sample_trial(const FitRequest& q, double scale, bool score, std::mt19937_6
   if (reads_rcond(q.config.solver)) {
     const std::vector<double> ladder =
         rcond_auto ? sampled::rcond_ladder() : std::vector<double>{*q.config.rcond};
-    t.rcond = sampled::choose_rcond(on, folds, q.config.solver, ladder, t.rcond_curve, &t.whole);
+    t.rcond = sampled::choose_rcond(on, folds, q.config, ladder, t.rcond_curve, &t.whole);
     t.error = std::ranges::min_element(t.rcond_curve, {}, &RcondTrial::error)->error;
   } else {
     t.error = sampled::held_out_error(on, folds, q.config);

@@ -39,18 +39,25 @@ enum class LeastSquaresSolver {
               // on its reduction by a QR of D (docs/sampled.md)
   kRidge,     // qr's reduction, then Tikhonov on its triangle R: the QR of [R; mu I] by dtpqrt,
               // mu = rcond times R's largest singular value, and one triangular solve
+  kSketch,    // ridge's problem by LSQR on [A; mu I], right-preconditioned by ridge's triangle of a
+              // sparse sketch of A (sketch.h): the sketch's QR instead of D's
 };
-inline constexpr NameTable<LeastSquaresSolver, 4> kLeastSquaresSolverNames{{
+inline constexpr NameTable<LeastSquaresSolver, 5> kLeastSquaresSolverNames{{
     {LeastSquaresSolver::kLsqr, "lsqr"},
     {LeastSquaresSolver::kCholesky, "cholesky"},
     {LeastSquaresSolver::kQr, "qr"},
     {LeastSquaresSolver::kRidge, "ridge"},
+    {LeastSquaresSolver::kSketch, "sketch"},
 }};
 
 /// Whether a solver reads SampledFitConfig::rcond (the others read regularization, and lsqr
 /// tolerance and max_iterations).
 constexpr bool reads_rcond(LeastSquaresSolver solver) {
   return solver != LeastSquaresSolver::kLsqr && solver != LeastSquaresSolver::kCholesky;
+}
+/// Whether a solver iterates (reads SampledFitConfig::tolerance and max_iterations).
+constexpr bool iterates(LeastSquaresSolver solver) {
+  return solver == LeastSquaresSolver::kLsqr || solver == LeastSquaresSolver::kSketch;
 }
 
 /// The peer's SWIM scale, atanh(1/2) = ln(3) / 2: a tanh neuron passes through -1/2 and +1/2 at
@@ -80,9 +87,10 @@ struct SampledFitConfig {
   /// raised tenfold until it succeeds (at most to 1e-6, or to lambda itself when larger; beyond,
   /// the system is called singular).
   double regularization = 1e-13;
-  /// kLsqr stops when the normal-equation residual |A^T r| falls below tolerance * |A| |r|.
+  /// kLsqr and kSketch stop when the preconditioned normal-equation residual |(A M)^T r| falls
+  /// below tolerance * |A M| |r|.
   double tolerance = 1e-14;
-  /// kLsqr's iteration cap.
+  /// kLsqr's and kSketch's iteration cap.
   int max_iterations = 200;
   /// kAswim: the first (U-SWIM) fit, whose outputs weight the pairs of the second, has this
   /// fraction of each hidden layer's width (at least 1 neuron). The peer fits it at full width

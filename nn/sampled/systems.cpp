@@ -1,8 +1,23 @@
 #include "nn/sampled/systems.h"
 
+#include <algorithm>
+
+#include "autodiff/parallel.h"
+#include "nn/sampled/sketch.h"
+
 namespace hnn::nn::sampled {
 
 using Eigen::Index;
+
+void LinearSystem::sketched(const SparseSign& sketch, ColMat& a, ColMat& b) const {
+  a = sketch.apply(formed());
+  b = sketch.apply(rhs());
+}
+
+void DenseSystem::sketched(const SparseSign& sketch, ColMat& a, ColMat& b) const {
+  a = sketch.apply(a_);
+  b = sketch.apply(b_);
+}
 
 void DenseSystem::gram(ColMat& g) const {
   blas_gram(a_.data(), a_.rows(), a_.cols(), a_.rows(), g, 0);
@@ -22,7 +37,7 @@ HadamardSystem::HadamardSystem(ColMat d, ColMat v, const ColMat& dxdt)
     : d_(std::move(d)), v_(std::move(v)), b_(dxdt.size(), 1) {
   b_ = dxdt.reshaped();  // column-major: coordinate i's targets, then i + 1's
   y_.resize(v_.rows(), d_.cols());
-  q_.resize(d_.cols(), v_.rows());
+  q_.resize(v_.rows(), d_.cols());
   p_.resize(d_.rows(), v_.rows());
 }
 
@@ -48,6 +63,59 @@ void HadamardSystem::gram(ColMat& g) const {
   }
 }
 
+namespace {
+
+// The narrow products of LSQR's iterations, D (N x w) against dim columns: each streams D from
+// memory once. OpenBLAS's GEMM first copies D into its packed panels, which for so few columns
+// cost more than the product. Rows (apply) and columns (apply_t) are split between threads; each
+// result entry is summed by one thread in a fixed order, so the bits do not depend on the thread
+// count.
+
+// Rows of p = D y^T per block: long enough that each column's piece of D spans pages (512-row
+// pieces measured 2.5x slower at N = 20000, w = 3000: a TLB miss a piece), short enough that p's
+// block stays in L2 while D's columns pass, four at a time.
+constexpr Index kNarrowRows = 2048;
+
+// p = D y^T (N x dim), y dim x w.
+void narrow_product(const ColMat& d, const ColMat& y, ColMat& p) {
+  const Index n = d.rows(), w = d.cols(), dim = y.rows();
+  const Index blocks = (n + kNarrowRows - 1) / kNarrowRows;
+  const int parts = int(std::min<Index>(blocks, ad::num_threads()));
+  ad::parallel_for(parts, [&](int part) {
+    const ad::RowBlock mine = ad::row_block(blocks, parts, part);
+    for (Index b = mine.begin; b < mine.end; ++b) {
+      const Index r0 = b * kNarrowRows, len = std::min(kNarrowRows, n - r0);
+      p.middleRows(r0, len).setZero();
+      Index k = 0;
+      for (; k + 4 <= w; k += 4) {  // p's block read and written once per four columns of D
+        const auto d0 = d.col(k).segment(r0, len), d1 = d.col(k + 1).segment(r0, len);
+        const auto d2 = d.col(k + 2).segment(r0, len), d3 = d.col(k + 3).segment(r0, len);
+        for (Index i = 0; i < dim; ++i) {
+          p.col(i).segment(r0, len) +=
+              y(i, k) * d0 + y(i, k + 1) * d1 + y(i, k + 2) * d2 + y(i, k + 3) * d3;
+        }
+      }
+      for (; k < w; ++k) {
+        for (Index i = 0; i < dim; ++i)
+          p.col(i).segment(r0, len) += y(i, k) * d.col(k).segment(r0, len);
+      }
+    }
+  });
+}
+
+// qt = p^T D (dim x w), p N x dim: column k's dim dot products in one pass over it (Eigen's GEMV
+// with p^T as a row-major left-hand side).
+void narrow_product_t(const ColMat& d, const ColMat& p, ColMat& qt) {
+  const Index w = d.cols();
+  const int parts = int(std::min<Index>(w, ad::num_threads()));
+  ad::parallel_for(parts, [&](int part) {
+    const ad::RowBlock cols = ad::row_block(w, parts, part);
+    for (Index k = cols.begin; k < cols.end; ++k) qt.col(k).noalias() = p.transpose() * d.col(k);
+  });
+}
+
+}  // namespace
+
 // A c: the field rows of coordinate i are D (sum_s v_is o c_s).
 void HadamardSystem::apply(const ColMat& c, ColMat& out) const {
   const Index w = d_.cols(), blocks = v_.cols() / w, dim = v_.rows();
@@ -58,9 +126,7 @@ void HadamardSystem::apply(const ColMat& c, ColMat& out) const {
           v_.row(i).segment(s * w, w).array() * c.col(0).segment(s * w, w).transpose().array();
     }
   }
-  // D (Y^T)^T, not D Y: OpenBLAS 0.3.21's small-matrix kernel for a narrow right-hand side
-  // mallocs on every call (autodiff/gemm.h), and LSQR calls this every iteration.
-  blas_gemm(d_, false, y_, true, p_);
+  narrow_product(d_, y_, p_);
   out.col(0) = Eigen::Map<const Eigen::VectorXd>(p_.data(), p_.size());
 }
 
@@ -68,12 +134,12 @@ void HadamardSystem::apply(const ColMat& c, ColMat& out) const {
 void HadamardSystem::apply_t(const ColMat& r, ColMat& out) const {
   const Index w = d_.cols(), blocks = v_.cols() / w, dim = v_.rows();
   p_ = Eigen::Map<const ColMat>(r.data(), d_.rows(), dim);
-  blas_gemm(d_, true, p_, false, q_);
+  narrow_product_t(d_, p_, q_);
   out.setZero();
   for (Index s = 0; s < blocks; ++s) {
     for (Index i = 0; i < dim; ++i) {
       out.col(0).segment(s * w, w).array() +=
-          v_.row(i).segment(s * w, w).transpose().array() * q_.col(i).array();
+          v_.row(i).segment(s * w, w).transpose().array() * q_.row(i).transpose().array();
     }
   }
 }
@@ -125,6 +191,16 @@ void HadamardSystem::merge_blocks(const ColMat& r, const ColMat& qtb, ColMat& a,
     d = qtb.col(i).head(w);
     qr_merge_triangle(a, t, b, d);
   }
+}
+
+// One sketch S of the points for every coordinate's row block: S embeds D's column space, so
+// I (x) S embeds A's, and the sketched problem is the Hadamard form of S D, reduced like this
+// one (a QR of S D and dim - 1 triangle merges). Sketching A's 4N rows directly to the same cost
+// (one QR of 2-4 times the unknowns, no merges) needed 45-85 LSQR iterations against this one's
+// 29 on the double pendulum at width 3000 (docs/sampled.md).
+void HadamardSystem::sketched(const SparseSign& sketch, ColMat& a, ColMat& b) const {
+  const ColMat sb = sketch.apply(b_.reshaped(d_.rows(), v_.rows()));
+  HadamardSystem(sketch.apply(d_), v_, sb).reduced(a, b);
 }
 
 std::size_t HadamardSystem::bytes() const {

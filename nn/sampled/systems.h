@@ -9,6 +9,8 @@
 
 namespace hnn::nn::sampled {
 
+class SparseSign;
+
 /// A problem with `unknowns()` x `rhs_columns()` unknowns C and equations()-row targets B.
 class LinearSystem {
  public:
@@ -30,6 +32,10 @@ class LinearSystem {
     a = formed();
     b = rhs();
   }
+  /// The rows a sketch mixes (sketch.h): the equations, or the points they come in blocks of.
+  virtual Eigen::Index sketch_rows() const { return equations(); }
+  /// The sketched problem S A, S B, reduced like reduced() when the system has a cheaper form.
+  virtual void sketched(const SparseSign& sketch, ColMat& a, ColMat& b) const;
   /// Bytes of the matrices the system holds.
   virtual std::size_t bytes() const = 0;
 };
@@ -46,6 +52,7 @@ class DenseSystem final : public LinearSystem {
   void apply(const ColMat& c, ColMat& out) const override;
   void apply_t(const ColMat& r, ColMat& out) const override;
   ColMat formed() const override { return a_; }
+  void sketched(const SparseSign& sketch, ColMat& a, ColMat& b) const override;
   std::size_t bytes() const override;
 
  private:
@@ -70,6 +77,9 @@ class HadamardSystem final : public LinearSystem {
   /// entries of Q^T b_i, as Q is the same for every block: dim * width rows instead of dim * N.
   /// With one column block (an HNN) the triangular row blocks are merged: width rows.
   void reduced(ColMat& a, ColMat& b) const override;
+  /// The sketch's rows are the points (one S for every coordinate's row block).
+  Eigen::Index sketch_rows() const override { return d_.rows(); }
+  void sketched(const SparseSign& sketch, ColMat& a, ColMat& b) const override;
   std::size_t bytes() const override;
 
  private:

@@ -10,7 +10,7 @@ namespace hnn::tasks {
 namespace {
 
 // Rows of a split evaluated at once.
-constexpr Eigen::Index kChunk = 4096;
+constexpr Eigen::Index kChunk = 512;
 
 }  // namespace
 

@@ -52,16 +52,17 @@ void check_solver_options(const FitConfig& fit, const nlohmann::json& settings,
   using nn::LeastSquaresSolver;
   const LeastSquaresSolver solver = fit.sampled.solver;
   const bool lsqr = solver == LeastSquaresSolver::kLsqr;
+  const bool iterates = nn::iterates(solver);
   struct SolverOption {
     const char* key;
     bool read;  // by this solver
     const char* readers;
   };
   const SolverOption options[] = {
-      {"rcond", nn::reads_rcond(solver), "qr and ridge"},
+      {"rcond", nn::reads_rcond(solver), "qr, ridge and sketch"},
       {"regularization", lsqr || solver == LeastSquaresSolver::kCholesky, "lsqr and cholesky"},
-      {"solver_tolerance", lsqr, "lsqr"},
-      {"solver_iterations", lsqr, "lsqr"}};
+      {"solver_tolerance", iterates, "lsqr and sketch"},
+      {"solver_iterations", iterates, "lsqr and sketch"}};
   for (const SolverOption& o : options) {
     HNN_TASKS_CHECK(
         o.read || !settings.contains(o.key), "{}: --{} does not apply to --solver {} (read by {})",

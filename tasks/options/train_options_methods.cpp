@@ -111,8 +111,9 @@ const TrainOption kMethodOptions[] = {
      .key = "swim_scale"},
     {.name = "rcond",
      .kind = ValueKind::kAutoOrFraction,
-     .help = "qr's and ridge's least-squares cutoff: singular values below rcond times the "
-             "largest do not shape the last layer (qr drops them, ridge damps them), a number in "
+     .help = "qr's, ridge's and sketch's least-squares cutoff: singular values below rcond times "
+             "the largest do not shape the last layer (qr drops them, ridge and sketch damp "
+             "them), a number in "
              "(0, 1) (the peer's 1e-13 suits exact dx/dt), or "
              "auto: the cutoff of 1e-14 ... 1e-1 with the smallest field error on a held-out "
              "tenth of the points, then refitted on all (default auto)",
@@ -123,8 +124,10 @@ const TrainOption kMethodOptions[] = {
     {.name = "solver",
      .kind = ValueKind::kChoice,
      .help = "The last layer's least-squares solver: lsqr (preconditioned iterations), cholesky "
-             "(regularised normal equations), qr (LAPACK's dgelsd, like numpy's lstsq) or ridge "
-             "(qr's reduction, then Tikhonov at rcond on its triangle) (default qr)",
+             "(regularised normal equations), qr (LAPACK's dgelsd, like numpy's lstsq), ridge "
+             "(qr's reduction, then Tikhonov at rcond on its triangle) or sketch (ridge's problem "
+             "by LSQR preconditioned with the QR of a sparse sketch: the sketch's QR instead of "
+             "the whole data's) (default qr)",
      .group = kFitGroup,
      .sweep_rank = 29,
      .applies_to = AppliesTo::kFieldTasks,
@@ -141,14 +144,15 @@ const TrainOption kMethodOptions[] = {
      .key = "regularization"},
     {.name = "solver-tolerance",
      .kind = ValueKind::kFraction,
-     .help = "lsqr stops when |A^T r| < this * |A| |r|, in (0, 1) (default 1e-14)",
+     .help = "lsqr and sketch stop when |(A M)^T r| < this * |A M| |r| (M their "
+             "preconditioner), in (0, 1) (default 1e-14)",
      .group = kFitGroup,
      .sweep_rank = 31,
      .applies_to = AppliesTo::kFieldTasks,
      .key = "solver_tolerance"},
     {.name = "solver-iterations",
      .kind = ValueKind::kInt,
-     .help = "lsqr's iteration cap, 1 to 100000 (default 200)",
+     .help = "lsqr's and sketch's iteration cap, 1 to 100000 (default 200)",
      .group = kFitGroup,
      .sweep_rank = 32,
      .applies_to = AppliesTo::kFieldTasks,

@@ -336,20 +336,49 @@ TEST(SampledFit, RegularizationAboveTheCapIsUsed) {
 TEST(SampledFit, LsqrIterationsAllocateNothing) {
   if (!HNN_COUNTS_ALLOCATIONS) GTEST_SKIP() << "allocations are not counted here";
   const Problem train = pendulum(300, 2);
-  auto allocations = [&](int iterations) {
-    std::mt19937_64 rng(1);
-    auto model = make_model<double>(model_config(ModelKind::kHnn, {60}), rng);
-    const SampledFitConfig fit{.swim_scale = kPeerSwimScale,  // no walk: one fit
-                               .solver = LeastSquaresSolver::kLsqr,
-                               .tolerance = 0,
-                               .max_iterations = iterations};
-    const long before = hnn::testing::allocation_count();
-    const SampledFitReport report = fit_sampled(*model, train.x, train.dxdt, fit);
-    EXPECT_EQ(report.iterations, iterations);
-    return hnn::testing::allocation_count() - before;
-  };
-  allocations(5);  // warms up the engine's and OpenBLAS's threads
-  EXPECT_EQ(allocations(25), allocations(5));
+  for (LeastSquaresSolver solver : {LeastSquaresSolver::kLsqr, LeastSquaresSolver::kSketch}) {
+    auto allocations = [&](int iterations) {
+      std::mt19937_64 rng(1);
+      auto model = make_model<double>(model_config(ModelKind::kHnn, {60}), rng);
+      const SampledFitConfig fit{.swim_scale = kPeerSwimScale,  // no walk: one fit
+                                 .rcond = 1e-12,
+                                 .solver = solver,
+                                 .tolerance = 0,
+                                 .max_iterations = iterations};
+      const long before = hnn::testing::allocation_count();
+      const SampledFitReport report = fit_sampled(*model, train.x, train.dxdt, fit);
+      EXPECT_EQ(report.iterations, iterations);
+      return hnn::testing::allocation_count() - before;
+    };
+    allocations(5);  // warms up the engine's and OpenBLAS's threads
+    EXPECT_EQ(allocations(25), allocations(5)) << int(solver);
+  }
+}
+
+// The sketch solver fits as ridge does (the same problem, solved iteratively from a sketch's QR
+// instead of the whole data's), given or with --rcond auto's walk.
+TEST(SampledFit, SketchFitsAsRidgeDoes) {
+  const Problem train = pendulum(3000, 2), test = pendulum(1000, 3);
+  for (ModelKind kind : {ModelKind::kHnn, ModelKind::kBaseline}) {
+    for (std::optional<double> rcond : {std::optional<double>(1e-10), std::optional<double>()}) {
+      std::mt19937_64 init(1);
+      auto ridge = make_model<double>(model_config(kind, {100}), init);
+      auto sketch = make_model<double>(model_config(kind, {100}), init);
+      const SampledFitReport ridge_report = fit_sampled(
+          *ridge, train.x, train.dxdt, {.rcond = rcond, .solver = LeastSquaresSolver::kRidge});
+      const SampledFitReport sketch_report = fit_sampled(
+          *sketch, train.x, train.dxdt, {.rcond = rcond, .solver = LeastSquaresSolver::kSketch});
+      EXPECT_EQ(sketch_report.solver, "sketch");
+      EXPECT_GT(sketch_report.iterations, 0);
+      EXPECT_EQ(sketch_report.rcond, ridge_report.rcond) << to_string(kind);
+      EXPECT_EQ(sketch_report.rcond_validation.size(), ridge_report.rcond_validation.size());
+      const double ridge_error = field_error(*ridge, test),
+                   sketch_error = field_error(*sketch, test);
+      EXPECT_LT(ridge_error, 1e-3) << to_string(kind);
+      EXPECT_NEAR(sketch_error, ridge_error, 0.05 * ridge_error)
+          << to_string(kind) << " rcond " << sketch_report.rcond << (rcond ? " given" : " auto");
+    }
+  }
 }
 
 }  // namespace

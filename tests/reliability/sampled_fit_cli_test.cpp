@@ -74,7 +74,7 @@ std::vector<BadOption> bad_fit_options() {
       {{"train", "spring", "--fit", "sampled", "--sampler", "gauss"},
        "--sampler: gauss not in {elm,uswim,aswim}"},
       {{"train", "spring", "--fit", "sampled", "--solver", "svd"},
-       "--solver: svd not in {lsqr,cholesky,qr,ridge}"},
+       "--solver: svd not in {lsqr,cholesky,qr,ridge,sketch}"},
       {{"train", "spring", "--fit", "sampled", "--rcond", "1"},
        "--rcond: expected auto or a number in (0, 1), got '1'"},
       {{"train", "spring", "--fit", "sampled", "--rcond", "often"},
@@ -98,14 +98,15 @@ std::vector<BadOption> bad_fit_options() {
   bad.insert(bad.end(), others.begin(), others.end());
   // A solver option the solver does not read (tasks/options/fit_options.h); qr by default.
   for (const auto& [solver, option, value, readers] : std::vector<std::array<std::string, 4>>{
-           {"lsqr", "--rcond", "1e-10", "qr and ridge"},
-           {"cholesky", "--rcond", "1e-10", "qr and ridge"},
+           {"lsqr", "--rcond", "1e-10", "qr, ridge and sketch"},
+           {"cholesky", "--rcond", "1e-10", "qr, ridge and sketch"},
            {"qr", "--regularization", "1e-8", "lsqr and cholesky"},
            {"ridge", "--regularization", "1e-8", "lsqr and cholesky"},
-           {"qr", "--solver-tolerance", "1e-8", "lsqr"},
-           {"cholesky", "--solver-tolerance", "1e-8", "lsqr"},
-           {"qr", "--solver-iterations", "50", "lsqr"},
-           {"ridge", "--solver-iterations", "50", "lsqr"}}) {
+           {"sketch", "--regularization", "1e-8", "lsqr and cholesky"},
+           {"qr", "--solver-tolerance", "1e-8", "lsqr and sketch"},
+           {"cholesky", "--solver-tolerance", "1e-8", "lsqr and sketch"},
+           {"qr", "--solver-iterations", "50", "lsqr and sketch"},
+           {"ridge", "--solver-iterations", "50", "lsqr and sketch"}}) {
     bad.push_back({{"train", "spring", "--fit", "sampled", "--solver", solver, option, value},
                    "spring: " + option + " does not apply to --solver " + solver + " (read by " +
                        readers + ")"});

@@ -1,0 +1,72 @@
+#pragma once
+// Sketch-and-precondition for ridge's problem min |A c - B|² + mu² |c|² (Rokhlin & Tygert 2008;
+// Blendenpik, Avron, Maymounkov & Toledo 2010; LSRN, Meng, Saunders & Mahoney 2014): the QR of a
+// sketch S A with a few times more rows than unknowns is a preconditioner under which LSQR on the
+// whole problem converges in a few dozen iterations, at the sketch's QR cost instead of A's.
+// Damping is what makes it work for sampled features: without it, R's near-dependent columns
+// (half of a SWIM layer's lie within 1e-13 of the others' span) make R^-1 unbounded
+// (docs/sampled.md, "The sketch solver").
+
+#include <cstdint>
+#include <vector>
+
+#include "nn/sampled/systems.h"
+
+namespace hnn::nn::sampled {
+
+/// Sketch rows per unknown: the embedding's distortion, and so LSQR's rate, improves with more;
+/// its QR costs more (docs/sampled.md measures 2 against 3 and 4).
+inline constexpr double kSketchRowsPerUnknown = 2;
+/// Nonzeros per input row of the sparse sign embedding (8: Tropp et al.'s robust choice; a
+/// CountSketch's 1 needs many more rows for the same distortion).
+inline constexpr int kSketchNonzeros = 8;
+
+/// A sparse sign embedding S (rows_out x rows_in): each input row is added to kSketchNonzeros
+/// distinct output rows with random signs and weight 1/sqrt(kSketchNonzeros), so that
+/// E |S x|² = |x|².
+class SparseSign {
+ public:
+  SparseSign(Eigen::Index rows_in, Eigen::Index rows_out, std::uint64_t seed);
+  Eigen::Index rows_in() const { return rows_in_; }
+  Eigen::Index rows_out() const { return rows_out_; }
+  /// S x (rows_out x x.cols()), column by column on the engine's threads: the same bits at any
+  /// thread count.
+  ColMat apply(const ColMat& x) const;
+
+ private:
+  Eigen::Index rows_in_, rows_out_;
+  int per_row_;
+  std::vector<std::int32_t> targets_;  // per_row_ output rows for each input row
+  std::vector<double> weights_;        // their signed weights
+};
+
+/// Ridge's problem on one system, by LSQR preconditioned with the sketch's triangle.
+class SketchedRidge {
+ public:
+  /// Sketches the system to kSketchRowsPerUnknown times its unknowns (no sketch when it has no
+  /// more rows than that: the preconditioner is then exact) and reduces it to a triangle.
+  SketchedRidge(const LinearSystem& system, std::uint64_t seed);
+
+  struct Solution {
+    ColMat c;
+    int iterations = 0;
+    std::size_t bytes = 0;  // the solve's own matrices
+  };
+  /// mu = rcond times A's largest singular value (largest()): the sketch's ridge solution,
+  /// improved by LSQR on the whole damped problem until Paige & Saunders' test 2 passes at
+  /// `tolerance` or after max_iterations.
+  Solution solve(double rcond, double tolerance, int max_iterations) const;
+
+  /// A's largest singular value, mu's scale: a few power steps on A^T A from the sketch's top
+  /// right singular vector.
+  double largest() const { return largest_; }
+  /// Bytes of the sketch's triangle and right-hand side.
+  std::size_t bytes() const;
+
+ private:
+  const LinearSystem& system_;
+  ColMat r_, b_;  // the sketched problem's triangle (unknowns square) and its targets
+  double largest_ = 0;
+};
+
+}  // namespace hnn::nn::sampled
