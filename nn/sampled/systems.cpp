@@ -1,6 +1,7 @@
 #include "nn/sampled/systems.h"
 
 #include <algorithm>
+#include <vector>
 
 #include "autodiff/parallel.h"
 #include "nn/sampled/sketch.h"
@@ -179,18 +180,29 @@ void HadamardSystem::reduced(ColMat& a, ColMat& b) const {
   }
 }
 
-// One column block: every row block R diag(v_i) is upper triangular, so the stack's QR is the
-// first block merged with the others one at a time (dtpqrt), and the reduction is w x w.
+// One column block: every row block R diag(v_i) is upper triangular, so the stack's QR merges
+// them pairwise (dtpqrt), and the reduction is w x w. A level's merges run side by side on the
+// engine's threads with one OpenBLAS thread each: LAPACK's dtpqrt gains little from OpenBLAS's
+// second thread (docs/sampled.md), so two merges take about the time of one.
 void HadamardSystem::merge_blocks(const ColMat& r, const ColMat& qtb, ColMat& a, ColMat& b) const {
   const Index w = d_.cols(), dim = v_.rows();
-  a = r * v_.row(0).asDiagonal();
-  b = qtb.col(0).head(w);
-  ColMat t(w, w), d(w, 1);
-  for (Index i = 1; i < dim; ++i) {
-    t.noalias() = r * v_.row(i).asDiagonal();
-    d = qtb.col(i).head(w);
-    qr_merge_triangle(a, t, b, d);
+  const auto count = std::size_t(dim);
+  std::vector<ColMat> triangle(count), target(count);
+  for (Index i = 0; i < dim; ++i) {
+    triangle[std::size_t(i)] = r * v_.row(i).asDiagonal();
+    target[std::size_t(i)] = qtb.col(i).head(w);
   }
+  for (Index step = 1; step < dim; step *= 2) {
+    const int pairs = int((dim - 1 - step) / (2 * step) + 1);  // i = 0, 2 step, ... with i + step < dim
+    const BlasThreads blas(pairs > 1 ? 1 : 0);
+    ad::parallel_for(pairs, [&](int pair) {
+      const auto i = std::size_t(2 * step * pair), j = i + std::size_t(step);
+      qr_merge_triangle(triangle[i], triangle[j], target[i], target[j]);
+      triangle[j] = ColMat();
+    });
+  }
+  a = std::move(triangle.front());
+  b = std::move(target.front());
 }
 
 // One sketch S of the points for every coordinate's row block: S embeds D's column space, so

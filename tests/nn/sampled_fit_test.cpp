@@ -364,10 +364,13 @@ TEST(SampledFit, SketchFitsAsRidgeDoes) {
       std::mt19937_64 init(1);
       auto ridge = make_model<double>(model_config(kind, {100}), init);
       auto sketch = make_model<double>(model_config(kind, {100}), init);
-      const SampledFitReport ridge_report = fit_sampled(
-          *ridge, train.x, train.dxdt, {.rcond = rcond, .solver = LeastSquaresSolver::kRidge});
-      const SampledFitReport sketch_report = fit_sampled(
-          *sketch, train.x, train.dxdt, {.rcond = rcond, .solver = LeastSquaresSolver::kSketch});
+      // the peer's scale: no scale walk
+      const SampledFitConfig fit{.swim_scale = kPeerSwimScale, .rcond = rcond};
+      SampledFitConfig ridge_fit = fit, sketch_fit = fit;
+      ridge_fit.solver = LeastSquaresSolver::kRidge;
+      sketch_fit.solver = LeastSquaresSolver::kSketch;
+      const SampledFitReport ridge_report = fit_sampled(*ridge, train.x, train.dxdt, ridge_fit);
+      const SampledFitReport sketch_report = fit_sampled(*sketch, train.x, train.dxdt, sketch_fit);
       EXPECT_EQ(sketch_report.solver, "sketch");
       EXPECT_GT(sketch_report.iterations, 0);
       EXPECT_EQ(sketch_report.rcond, ridge_report.rcond) << to_string(kind);
