@@ -193,7 +193,8 @@ void HadamardSystem::merge_blocks(const ColMat& r, const ColMat& qtb, ColMat& a,
     target[std::size_t(i)] = qtb.col(i).head(w);
   }
   for (Index step = 1; step < dim; step *= 2) {
-    const int pairs = int((dim - 1 - step) / (2 * step) + 1);  // i = 0, 2 step, ... with i + step < dim
+    const int pairs =
+        int((dim - 1 - step) / (2 * step) + 1);  // i = 0, 2 step, ... with i + step < dim
     const BlasThreads blas(pairs > 1 ? 1 : 0);
     ad::parallel_for(pairs, [&](int pair) {
       const auto i = std::size_t(2 * step * pair), j = i + std::size_t(step);
