@@ -148,18 +148,28 @@ void reduce_to_triangle(ColMat& a, ColMat& b) {
   b.conservativeResize(a.cols(), Eigen::NoChange);
 }
 
-double largest_singular_value(const ColMat& r, int iterations, Eigen::VectorXd* vector) {
-  const auto upper = r.triangularView<Eigen::Upper>();
-  Eigen::VectorXd v = Eigen::VectorXd::Ones(r.cols()), u;
+double largest_singular_value(const NormalProduct& normal, Eigen::VectorXd v, int iterations,
+                              Eigen::VectorXd* vector) {
+  Eigen::VectorXd product(v.size());
   double sigma = 0;
   for (int i = 0; i < iterations && v.norm() > 0; ++i) {
     v.normalize();
-    u.noalias() = upper * v;
-    v.noalias() = upper.transpose() * u;
-    sigma = std::sqrt(v.norm());
+    normal(v, product);
+    sigma = std::sqrt(product.norm());
+    v.swap(product);
   }
   if (vector != nullptr) *vector = v.norm() > 0 ? Eigen::VectorXd(v.normalized()) : v;
   return sigma;
+}
+
+double largest_singular_value(const ColMat& r, int iterations, Eigen::VectorXd* vector) {
+  const auto upper = r.triangularView<Eigen::Upper>();
+  Eigen::VectorXd u;
+  const auto normal = [&](const Eigen::VectorXd& v, Eigen::VectorXd& out) {
+    u.noalias() = upper * v;
+    out.noalias() = upper.transpose() * u;
+  };
+  return largest_singular_value(normal, Eigen::VectorXd::Ones(r.cols()), iterations, vector);
 }
 
 }  // namespace hnn::nn::sampled

@@ -3,6 +3,7 @@
 // LAPACK): column-major Eigen matrices handed to cblas and to LAPACK's Fortran routines.
 
 #include <Eigen/Core>
+#include <functional>
 
 namespace hnn::nn::sampled {
 
@@ -49,9 +50,14 @@ int lstsq_svd(ColMat& a, ColMat& b, double rcond);
 /// (2/3 n^3 FLOP, a merge of qr_merge_triangle), then one triangular solve. r is overwritten by
 /// the stack's triangle; b (n x m) returns x.
 void ridge_triangle(ColMat& r, ColMat& b, double mu);
-/// The largest singular value of an upper-triangular r, from `iterations` power steps on r^T r
-/// (an estimate from below, matrix-vector products only: enough to place a cutoff a decade
-/// apart from the next), and in `vector` the last step's unit vector when given.
+/// out = A^T A v for some A: what power steps read.
+using NormalProduct = std::function<void(const Eigen::VectorXd& v, Eigen::VectorXd& out)>;
+/// A's largest singular value from `iterations` power steps on A^T A started at `start` (an
+/// estimate from below, matrix-vector products only: enough to place a cutoff a decade apart
+/// from the next), and in `vector` the last step's unit vector when given.
+double largest_singular_value(const NormalProduct& normal, Eigen::VectorXd start, int iterations,
+                              Eigen::VectorXd* vector = nullptr);
+/// The same for an upper-triangular r (A = r), from the ones vector.
 double largest_singular_value(const ColMat& r, int iterations = 20,
                               Eigen::VectorXd* vector = nullptr);
 /// a <- its QR's triangle (a.cols() square) and b <- the first a.cols() rows of Q^T b, unless a

@@ -1,7 +1,6 @@
 #pragma once
 // The solvers of the last layer's least-squares problem (LeastSquaresSolver in sampled_fit.h).
 
-#include <cstdint>
 #include <string>
 
 #include "nn/sampled/sampled_fit.h"
@@ -26,12 +25,6 @@ struct ReducedProblem {
   ColMat r, c;
   bool empty() const { return r.size() == 0; }
 };
-
-/// The sketch solver's seed for a fit's: a stream of its own, so that the sketch draws nothing
-/// from the sampler's.
-constexpr std::uint64_t sketch_seed(std::uint64_t fit_seed) {
-  return fit_seed ^ 0x736b65746368ULL;  // "sketch"
-}
 
 /// Solves min |A C - B| by config.solver; throws std::invalid_argument when the system is
 /// singular beyond what the regularisation repairs, or when the solution is not finite. qr and

@@ -7,12 +7,12 @@ namespace hnn::nn::sampled {
 void Preconditioner::apply(const ColMat& y, ColMat& c) const {
   c = y;
   solve_upper(r, false, c);
-  c.array().colwise() *= s.array();
+  if (s.size() > 0) c.array().colwise() *= s.array();
 }
 
 void Preconditioner::apply_t(const ColMat& c, ColMat& y) const {
   y = c;
-  y.array().colwise() *= s.array();
+  if (s.size() > 0) y.array().colwise() *= s.array();
   solve_upper(r, true, y);
 }
 

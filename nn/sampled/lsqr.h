@@ -7,10 +7,11 @@
 
 namespace hnn::nn::sampled {
 
-/// The right preconditioner M = S R^-1: R upper triangular, S a column scaling.
+/// The right preconditioner M = S R^-1: R upper triangular, S a column scaling (none when s is
+/// empty).
 struct Preconditioner {
   ColMat r;
-  Eigen::VectorXd s;
+  Eigen::VectorXd s{};
 
   void apply(const ColMat& y, ColMat& c) const;    // c = S R^-1 y, in c's own memory
   void apply_t(const ColMat& c, ColMat& y) const;  // y = R^-T S c

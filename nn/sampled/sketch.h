@@ -8,7 +8,6 @@
 // (docs/sampled.md, "The sketch solver").
 
 #include <cstdint>
-#include <vector>
 
 #include "nn/sampled/systems.h"
 
@@ -17,28 +16,11 @@ namespace hnn::nn::sampled {
 /// Sketch rows per unknown: the embedding's distortion, and so LSQR's rate, improves with more;
 /// its QR costs more (docs/sampled.md measures 2 against 3 and 4).
 inline constexpr double kSketchRowsPerUnknown = 2;
-/// Nonzeros per input row of the sparse sign embedding (8: Tropp et al.'s robust choice; a
-/// CountSketch's 1 needs many more rows for the same distortion).
-inline constexpr int kSketchNonzeros = 8;
-
-/// A sparse sign embedding S (rows_out x rows_in): each input row is added to kSketchNonzeros
-/// distinct output rows with random signs and weight 1/sqrt(kSketchNonzeros), so that
-/// E |S x|² = |x|².
-class SparseSign {
- public:
-  SparseSign(Eigen::Index rows_in, Eigen::Index rows_out, std::uint64_t seed);
-  Eigen::Index rows_in() const { return rows_in_; }
-  Eigen::Index rows_out() const { return rows_out_; }
-  /// S x (rows_out x x.cols()), column by column on the engine's threads: the same bits at any
-  /// thread count.
-  ColMat apply(const ColMat& x) const;
-
- private:
-  Eigen::Index rows_in_, rows_out_;
-  int per_row_;
-  std::vector<std::int32_t> targets_;  // per_row_ output rows for each input row
-  std::vector<double> weights_;        // their signed weights
-};
+/// The sketch's seed for a fit's: a stream of its own, so that the sketch draws nothing from the
+/// sampler's.
+constexpr std::uint64_t sketch_seed(std::uint64_t fit_seed) {
+  return fit_seed ^ 0x736b65746368ULL;  // "sketch"
+}
 
 /// Ridge's problem on one system, by LSQR preconditioned with the sketch's triangle.
 class SketchedRidge {

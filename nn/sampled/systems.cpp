@@ -4,7 +4,7 @@
 #include <vector>
 
 #include "autodiff/parallel.h"
-#include "nn/sampled/sketch.h"
+#include "nn/sampled/sparse_sign.h"
 
 namespace hnn::nn::sampled {
 

@@ -10,6 +10,7 @@
 #include "autodiff/parallel.h"
 #include "nn/sampled/lsqr.h"
 #include "nn/sampled/sketch.h"
+#include "nn/sampled/sparse_sign.h"
 #include "nn/sampled/systems.h"
 
 namespace hnn::nn::sampled {
