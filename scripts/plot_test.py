@@ -2,7 +2,7 @@
 """Tests scripts/plot.py (the charts of scripts/charts/: fig2, fig3, training_curves, table1) on
 the synthetic results folder of scripts/plot_fixtures.py, and its --runs mode (Figure 2 of run
 folders) on synthetic runs of the data task. The other commands' tests: plot_pixel_test.py,
-plot_study_test.py; ctest runs all three as scripts.PlotCharts (tests/CMakeLists.txt).
+plot_study_test.py; ctest runs each as scripts.PlotCharts.<chart> (tests/CMakeLists.txt).
 
 Usage: /usr/bin/python3 scripts/plot_test.py [-v]      (KEEP=DIR keeps the folder in DIR)
 """

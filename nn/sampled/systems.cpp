@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "autodiff/parallel.h"
+#include "nn/sampled/narrow.h"
 #include "nn/sampled/sparse_sign.h"
 
 namespace hnn::nn::sampled {
@@ -63,59 +64,6 @@ void HadamardSystem::gram(ColMat& g) const {
     }
   }
 }
-
-namespace {
-
-// The narrow products of LSQR's iterations, D (N x w) against dim columns: each streams D from
-// memory once. OpenBLAS's GEMM first copies D into its packed panels, which for so few columns
-// cost more than the product. Rows (apply) and columns (apply_t) are split between threads; each
-// result entry is summed by one thread in a fixed order, so the bits do not depend on the thread
-// count.
-
-// Rows of p = D y^T per block: long enough that each column's piece of D spans pages (512-row
-// pieces measured 2.5x slower at N = 20000, w = 3000: a TLB miss a piece), short enough that p's
-// block stays in L2 while D's columns pass, four at a time.
-constexpr Index kNarrowRows = 2048;
-
-// p = D y^T (N x dim), y dim x w.
-void narrow_product(const ColMat& d, const ColMat& y, ColMat& p) {
-  const Index n = d.rows(), w = d.cols(), dim = y.rows();
-  const Index blocks = (n + kNarrowRows - 1) / kNarrowRows;
-  const int parts = int(std::min<Index>(blocks, ad::num_threads()));
-  ad::parallel_for(parts, [&](int part) {
-    const ad::RowBlock mine = ad::row_block(blocks, parts, part);
-    for (Index b = mine.begin; b < mine.end; ++b) {
-      const Index r0 = b * kNarrowRows, len = std::min(kNarrowRows, n - r0);
-      p.middleRows(r0, len).setZero();
-      Index k = 0;
-      for (; k + 4 <= w; k += 4) {  // p's block read and written once per four columns of D
-        const auto d0 = d.col(k).segment(r0, len), d1 = d.col(k + 1).segment(r0, len);
-        const auto d2 = d.col(k + 2).segment(r0, len), d3 = d.col(k + 3).segment(r0, len);
-        for (Index i = 0; i < dim; ++i) {
-          p.col(i).segment(r0, len) +=
-              y(i, k) * d0 + y(i, k + 1) * d1 + y(i, k + 2) * d2 + y(i, k + 3) * d3;
-        }
-      }
-      for (; k < w; ++k) {
-        for (Index i = 0; i < dim; ++i)
-          p.col(i).segment(r0, len) += y(i, k) * d.col(k).segment(r0, len);
-      }
-    }
-  });
-}
-
-// qt = p^T D (dim x w), p N x dim: column k's dim dot products in one pass over it (Eigen's GEMV
-// with p^T as a row-major left-hand side).
-void narrow_product_t(const ColMat& d, const ColMat& p, ColMat& qt) {
-  const Index w = d.cols();
-  const int parts = int(std::min<Index>(w, ad::num_threads()));
-  ad::parallel_for(parts, [&](int part) {
-    const ad::RowBlock cols = ad::row_block(w, parts, part);
-    for (Index k = cols.begin; k < cols.end; ++k) qt.col(k).noalias() = p.transpose() * d.col(k);
-  });
-}
-
-}  // namespace
 
 // A c: the field rows of coordinate i are D (sum_s v_is o c_s).
 void HadamardSystem::apply(const ColMat& c, ColMat& out) const {

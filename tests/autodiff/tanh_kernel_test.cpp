@@ -97,7 +97,9 @@ TEST(TanhKernel, DoubleIsWithinAFewUlpsOfOneOfTheTrueTanh) {
   for (Eigen::Index i = 0; i < x.cols(); ++i) {
     const long double truth = std::tanh(static_cast<long double>(x(0, i)));
     worst = std::max(worst, double(std::abs(static_cast<long double>(y(0, i)) - truth)));
-    if (i > 0 && std::abs(x(0, i)) < 5) EXPECT_LT(y(0, i - 1), y(0, i)) << x(0, i);
+    if (i > 0 && std::abs(x(0, i)) < 5) {
+      EXPECT_LT(y(0, i - 1), y(0, i)) << x(0, i);
+    }
   }
   EXPECT_LT(worst, 4 * std::numeric_limits<double>::epsilon());
 }
