@@ -16,6 +16,10 @@ namespace hnn::nn::sampled {
 /// Sketch rows per unknown: the embedding's distortion, and so LSQR's rate, improves with more;
 /// its QR costs more (docs/sampled.md measures 2 against 3 and 4).
 inline constexpr double kSketchRowsPerUnknown = 2;
+/// Where mu |R^-1| stays below this, the preconditioner is R itself instead of the triangle of
+/// [R; mu I], whose merge costs as much as one of the reduction's (0.55 s at width 3000): the
+/// damping rows then add at most this much to the preconditioned singular values' spread.
+inline constexpr double kNegligibleDamping = 0.1;
 /// The sketch's seed for a fit's: a stream of its own, so that the sketch draws nothing from the
 /// sampler's.
 constexpr std::uint64_t sketch_seed(std::uint64_t fit_seed) {
@@ -49,6 +53,7 @@ class SketchedRidge {
   const LinearSystem& system_;
   ColMat r_, b_;  // the sketched problem's triangle (unknowns square) and its targets
   double largest_ = 0;
+  double inverse_norm_ = 0;  // |R^-1|, from below (power steps)
 };
 
 }  // namespace hnn::nn::sampled
