@@ -88,6 +88,23 @@ void activate(Activation activation, const ColMat& z, ColMat& value, ColMat* slo
   });
 }
 
+void activation_slope(Activation activation, ColMat& z) {
+  const int parts = ad::parts_for(z.size(), 1 << 14);
+  ad::parallel_for(parts, [&](int part) {
+    const ad::RowBlock block = ad::row_block(z.size(), parts, part);
+    if (activation == Activation::kTanh) {
+      const Index n = block.end - block.begin;
+      ad::detail::tanh_values(z.data() + block.begin, z.data() + block.begin, n);
+      z.reshaped().segment(block.begin, n) =
+          1 - z.reshaped().segment(block.begin, n).array().square();
+      return;
+    }
+    double f = 0;
+    for (Index k = block.begin; k < block.end; ++k)
+      activate_one(activation, z.data()[k], f, z.data()[k]);
+  });
+}
+
 ColMat pre_activation(const HiddenLayer& layer, const ColMat& u) {
   ColMat z(u.rows(), layer.w.cols());
   blas_gemm(u, false, layer.w, false, z);
