@@ -16,7 +16,9 @@ struct Shape {
 
 // Sizes off every multiple the kernels step by: rows not a whole packet or row unit, widths not
 // a whole group of columns, dims above and below the kernels' 4.
-constexpr Shape kShapes[] = {{1, 1, 1}, {7, 5, 2}, {130, 9, 3}, {1027, 13, 4}, {2500, 17, 6}};
+// {3000, 5, 3}: four times its rows (the bits test's) span more than one piece of p at 3 dims.
+constexpr Shape kShapes[] = {{1, 1, 1},     {7, 5, 2},     {130, 9, 3},
+                             {1027, 13, 4}, {2500, 17, 6}, {3000, 5, 3}};
 
 ColMat random(Index rows, Index cols, unsigned seed) {
   std::srand(seed);

@@ -25,7 +25,9 @@ TEST(SampledSketch, SparseSignHasItsNonzerosPerRow) {
   for (Index i = 0; i < 50; ++i) {
     EXPECT_EQ((formed.col(i).array() != 0).count(), kSketchNonzeros) << "row " << i;
     for (Index r = 0; r < 30; ++r) {
-      if (formed(r, i) != 0) EXPECT_DOUBLE_EQ(std::abs(formed(r, i)), 1 / std::sqrt(8.0));
+      if (formed(r, i) != 0) {
+        EXPECT_DOUBLE_EQ(std::abs(formed(r, i)), 1 / std::sqrt(8.0));
+      }
     }
   }
   EXPECT_EQ(formed, SparseSign(50, 30, 7).apply(ColMat::Identity(50, 50)));  // seeded
