@@ -26,7 +26,8 @@ ColMat mlp_input(const DynamicsConfig& config, const ColMat& x) {
 
 namespace {
 
-// act and act' of one value.
+// act and act' of one value; f and df may be one double (activate in place): f is written
+// first, and df reads only t and f.
 void activate_one(Activation activation, double t, double& f, double& df) {
   constexpr double kSeluAlpha = 1.6732632423543772, kSeluScale = 1.0507009873554805;
   switch (activation) {
@@ -85,23 +86,6 @@ void activate(Activation activation, const ColMat& z, ColMat& value, ColMat* slo
     for (Index k = block.begin; k < block.end; ++k) {
       activate_one(activation, z.data()[k], value.data()[k], slope ? slope->data()[k] : df);
     }
-  });
-}
-
-void activation_slope(Activation activation, ColMat& z) {
-  const int parts = ad::parts_for(z.size(), 1 << 14);
-  ad::parallel_for(parts, [&](int part) {
-    const ad::RowBlock block = ad::row_block(z.size(), parts, part);
-    if (activation == Activation::kTanh) {
-      const Index n = block.end - block.begin;
-      ad::detail::tanh_values(z.data() + block.begin, z.data() + block.begin, n);
-      z.reshaped().segment(block.begin, n) =
-          1 - z.reshaped().segment(block.begin, n).array().square();
-      return;
-    }
-    double f = 0;
-    for (Index k = block.begin; k < block.end; ++k)
-      activate_one(activation, z.data()[k], f, z.data()[k]);
   });
 }
 

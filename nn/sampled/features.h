@@ -20,11 +20,10 @@ struct HiddenLayer {
 /// the angles, sin of the angles, the other coordinates), as DynamicsModel::mlp_input.
 ColMat mlp_input(const DynamicsConfig& config, const ColMat& x);
 
-/// act(z) and act'(z) of the activation, elementwise; `slope` may be null, `value` may be z.
+/// act(z) and act'(z) of the activation, elementwise; `slope` may be null, `value` may be z, and
+/// so may both: z then ends as act'(z) (an HNN's system needs the slope alone, and at width 3000
+/// on 20k points the values would be another 480 MB).
 void activate(Activation activation, const ColMat& z, ColMat& value, ColMat* slope);
-/// z <- act'(z) in place, the same bits as activate's slope: an HNN's system needs the slope
-/// alone, and at width 3000 on 20k points the values would be another 480 MB.
-void activation_slope(Activation activation, ColMat& z);
 
 /// The pre-activation u w + b of a layer.
 ColMat pre_activation(const HiddenLayer& layer, const ColMat& u);

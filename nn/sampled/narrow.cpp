@@ -20,7 +20,7 @@ constexpr Index kLanes = Eigen::internal::packet_traits<double>::size;
 constexpr int kDims = 4;
 constexpr int kDotColumns = 4;
 constexpr int kAxpyColumns = 8;
-constexpr int kMaxColumns = 8;
+constexpr int kMaxColumns = std::max(kDotColumns, kAxpyColumns);
 using Columns = std::array<const double*, kMaxColumns>;
 
 // out(i, c) = p_i . d_c over rows [0, n), for C columns and D dims; out column-major (ldo).
@@ -90,6 +90,15 @@ void with_dims(int dims, F&& f) {
   }
 }
 
+// Columns i0 .. i0 + kDims of p (fewer at its end): one kernel call's coordinates.
+template <typename Pointer, typename Matrix>
+std::array<Pointer, kDims> dims_of(Matrix& p, Index i0) {
+  std::array<Pointer, kDims> out{};
+  for (Index i = i0; i < std::min(p.cols(), i0 + kDims); ++i)
+    out[std::size_t(i - i0)] = p.col(i).data();
+  return out;
+}
+
 Columns columns_of(const ColMat& d, Index k, int count) {
   Columns out{};
   for (int c = 0; c < count; ++c) out[std::size_t(c)] = d.col(k + c).data();
@@ -123,9 +132,7 @@ void narrow_product(const ColMat& d, const ColMat& y, ColMat& p) {
       const Index len = std::min(step, end - r0);
       p.middleRows(r0, len).setZero();
       for (Index i0 = 0; i0 < dim; i0 += kDims) {
-        std::array<double*, kDims> pi{};
-        for (Index i = i0; i < std::min(dim, i0 + kDims); ++i)
-          pi[std::size_t(i - i0)] = p.col(i).data();
+        const auto pi = dims_of<double*>(p, i0);
         with_dims(int(std::min<Index>(kDims, dim - i0)), [&]<int D>() {
           Index k = 0;
           for (; k + kAxpyColumns <= w; k += kAxpyColumns) {
@@ -148,9 +155,7 @@ void narrow_product_t(const ColMat& d, const ColMat& p, ColMat& qt) {
     const ad::RowBlock mine = ad::row_block(groups, parts, part);
     const Index begin = mine.begin * kDotColumns, end = std::min(w, mine.end * kDotColumns);
     for (Index i0 = 0; i0 < dim; i0 += kDims) {
-      std::array<const double*, kDims> pi{};
-      for (Index i = i0; i < std::min(dim, i0 + kDims); ++i)
-        pi[std::size_t(i - i0)] = p.col(i).data();
+      const auto pi = dims_of<const double*>(p, i0);
       with_dims(int(std::min<Index>(kDims, dim - i0)), [&]<int D>() {
         Index k = begin;
         for (; k + kDotColumns <= end; k += kDotColumns) {

@@ -137,7 +137,7 @@ std::unique_ptr<sampled::LinearSystem> last_layer_system(const DynamicsConfig& m
   const HiddenLayer& layer = layers.front();
   const Index w = layer.w.cols();
   ColMat slope = sampled::pre_activation(layer, sampled::mlp_input(mc, x));
-  sampled::activation_slope(mc.activation, slope);
+  sampled::activate(mc.activation, slope, slope, &slope);  // in place: the slope alone
   const auto terms = sampled::field_terms(mc);
   ColMat v(mc.dim, Index(terms.size()) * w);
   for (std::size_t s = 0; s < terms.size(); ++s) {

@@ -105,13 +105,18 @@ ColMat HadamardSystem::formed() const {
 }
 
 void HadamardSystem::reduced(ColMat& a, ColMat& b) const {
-  const Index n = d_.rows(), w = d_.cols(), dim = v_.rows();
+  const Index n = d_.rows(), w = d_.cols();
   if (n < w) {  // fewer points than neurons: D has no square R, and A is no taller than R's form
     LinearSystem::reduced(a, b);
     return;
   }
-  ColMat q = d_;
-  ColMat qtb = b_.reshaped(n, dim);
+  reduce_points(d_, b_.reshaped(n, v_.rows()), a, b);
+}
+
+// q: the points' matrix (D or S D), overwritten by its QR; qtb: their targets, a column per
+// coordinate.
+void HadamardSystem::reduce_points(ColMat q, ColMat qtb, ColMat& a, ColMat& b) const {
+  const Index w = d_.cols(), dim = v_.rows();
   const ColMat r = qr_apply(q, qtb);
   q = ColMat();
   if (v_.cols() == w) {
@@ -160,8 +165,7 @@ void HadamardSystem::merge_blocks(const ColMat& r, const ColMat& qtb, ColMat& a,
 // (one QR of 2-4 times the unknowns, no merges) needed 45-85 LSQR iterations against this one's
 // 29 on the double pendulum at width 3000 (docs/sampled.md).
 void HadamardSystem::sketched(const SparseSign& sketch, ColMat& a, ColMat& b) const {
-  const ColMat sb = sketch.apply(b_.reshaped(d_.rows(), v_.rows()));
-  HadamardSystem(sketch.apply(d_), v_, sb).reduced(a, b);
+  reduce_points(sketch.apply(d_), sketch.apply(b_.reshaped(d_.rows(), v_.rows())), a, b);
 }
 
 std::size_t HadamardSystem::bytes() const {

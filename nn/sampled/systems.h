@@ -83,6 +83,7 @@ class HadamardSystem final : public LinearSystem {
   std::size_t bytes() const override;
 
  private:
+  void reduce_points(ColMat q, ColMat qtb, ColMat& a, ColMat& b) const;
   void merge_blocks(const ColMat& r, const ColMat& qtb, ColMat& a, ColMat& b) const;
 
   ColMat d_, v_, b_;          // b_: N * dim x 1, coordinate-major (row i * N + n)
