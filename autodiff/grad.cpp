@@ -1,6 +1,7 @@
 #include "autodiff/grad.h"
 
 #include <algorithm>
+#include <atomic>
 #include <memory>
 #include <span>
 #include <utility>
@@ -15,7 +16,10 @@ namespace ad = ::hnn::ad;
 
 namespace {
 
-thread_local std::uint64_t g_sweep_id = 0;
+// One counter for every thread: a node keeps the id of the last sweep that visited it, and leaves
+// are reached from several threads (an LNN's rollouts sweep through the same parameters on every
+// engine thread), so an id one thread hands out must never be another's too.
+std::atomic<std::uint64_t> g_sweep_id{0};
 
 // A sweep's working lists, kept per thread so that repeated sweeps allocate nothing. Sweeps can
 // nest (a backward formula may call grad), hence a stack of them.
@@ -65,7 +69,7 @@ class Sweep : public GradSink<T> {
  public:
   // targets: the nodes whose gradients are wanted; all_leaves: every leaf is a target.
   Sweep(SweepBuffers<T>& buffers, bool all_leaves)
-      : id_(++g_sweep_id),
+      : id_(g_sweep_id.fetch_add(1, std::memory_order_relaxed) + 1),
         targets_(buffers.targets),
         all_leaves_(all_leaves),
         order_(buffers.order),

@@ -27,10 +27,16 @@ thread_local bool g_inside_part = false;
 // depend on who claimed what. A job may have more parts than the pool has threads (an
 // evaluation's rollouts, one part each): whoever finishes a part claims the next. One job at a
 // time: a caller that finds the pool busy runs its parts itself.
+// Note [Pinned parts]: a job of parallel_for_each_thread runs part i on thread i. Claimed parts
+// go to whoever gets there first, so from one call to the next a thread may run another part;
+// where parts keep buffers per thread (a step split by rows: each thread's tape) and the parts'
+// sizes differ by a row, every swap resized those buffers, allocating in steady state. A pinned
+// job is published with all its parts claimed; each worker whose index is below the parts runs
+// its own once, and the caller runs part 0.
 class Pool {
  public:
   explicit Pool(int threads) : errors_(std::size_t(threads)) {  // a step's jobs: no allocation
-    for (int i = 1; i < threads; ++i) workers_.emplace_back([this] { work(); });
+    for (int i = 1; i < threads; ++i) workers_.emplace_back([this, i] { work(i); });
   }
   ~Pool() {
     stop_.store(true);
@@ -40,7 +46,8 @@ class Pool {
   }
   int threads() const { return int(workers_.size()) + 1; }
 
-  void run(int parts, PartFn part) {
+  // pinned: part i runs on thread i (the caller is 0), none is claimed (Note [Pinned parts]).
+  void run(int parts, PartFn part, bool pinned) {
     std::unique_lock lock(busy_, std::try_to_lock);
     if (!lock.owns_lock() || std::uint64_t(parts) > kField) return serial(parts, part);
     job_ = &part;
@@ -48,10 +55,17 @@ class Pool {
     std::fill_n(errors_.begin(), parts, nullptr);
     done_.store(0, std::memory_order_relaxed);
     generation_ += kGeneration;
-    // Publishes the job (release: job_ and the reset counters are visible to whoever claims).
-    claim_.store(generation_ | std::uint64_t(parts) << kPartsShift, std::memory_order_release);
+    // Publishes the job (release: job_ and the reset counters are visible to whoever claims). A
+    // pinned job is published with every part claimed.
+    const std::uint64_t next = pinned ? std::uint64_t(parts) : 0;
+    claim_.store(generation_ | (pinned ? kPinned : 0) | std::uint64_t(parts) << kPartsShift | next,
+                 std::memory_order_release);
     claim_.notify_all();
-    for (int i = claim().part; i >= 0; i = claim().part) run_part(i, parts);
+    if (pinned) {
+      run_part(0, parts);
+    } else {
+      for (int i = claim().part; i >= 0; i = claim().part) run_part(i, parts);
+    }
     for (int d = done_.load(std::memory_order_acquire); d != parts;
          d = done_.load(std::memory_order_acquire)) {
       done_.wait(d);
@@ -62,9 +76,10 @@ class Pool {
   }
 
  private:
-  // The claim word: generation (bits 32..63, one step per job), the job's parts (16..31) and the
-  // next unclaimed part (0..15).
-  static constexpr std::uint64_t kGeneration = std::uint64_t(1) << 32;
+  // The claim word: generation (bits 33..63, one step per job), whether the job is pinned (32),
+  // the job's parts (16..31) and the next unclaimed part (0..15).
+  static constexpr std::uint64_t kGeneration = std::uint64_t(1) << 33;
+  static constexpr std::uint64_t kPinned = std::uint64_t(1) << 32;
   static constexpr int kPartsShift = 16;
   static constexpr std::uint64_t kField = 0xFFFF;
   static constexpr std::chrono::microseconds kSpin{500};  // Note [Brief spin]
@@ -101,13 +116,22 @@ class Pool {
     if (done_.fetch_add(1, std::memory_order_acq_rel) + 1 == parts) done_.notify_one();
   }
 
-  void work() {
+  void work(int index) {
+    std::uint64_t ran = 0;  // the generation of the last pinned job this worker ran its part of
     while (true) {
       // Claiming orders this after the job's publication, so job_ is the claimed part's job
       // (whose caller cannot publish another before this part is done).
       Claimed c = claim();
       for (; c.part >= 0; c = claim()) run_part(c.part, c.parts);
       if (stop_.load()) return;  // after the claim: a word seen after ~Pool's change means stop
+      // A pinned job's part `index`, once: its caller waits for it, so job_ is still that job.
+      const std::uint64_t generation = c.word & ~(kGeneration - 1);
+      const int parts = int((c.word >> kPartsShift) & kField);
+      if ((c.word & kPinned) && generation != ran && index < parts) {
+        ran = generation;
+        run_part(index, parts);
+        continue;  // the caller may have published the next job meanwhile
+      }
       if (!spin_until_changed(c.word)) claim_.wait(c.word);  // until a new job or ~Pool
     }
   }
@@ -174,13 +198,26 @@ void set_num_threads(int n) {
 
 int num_threads() { return g_threads.load(std::memory_order_relaxed); }
 
+int available_threads() { return g_inside_part ? 1 : num_threads(); }
+
 void parallel_for(int parts, PartFn part) {
   HNN_AD_CHECK(parts >= 1, "parallel_for: need at least 1 part, got {}", parts);
   if (parts == 1 || g_inside_part) {
     for (int i = 0; i < parts; ++i) part(i);
     return;
   }
-  pool()->run(parts, part);
+  pool()->run(parts, part, /*pinned=*/false);
+}
+
+void parallel_for_each_thread(int parts, PartFn part) {
+  HNN_AD_CHECK(parts >= 1 && parts <= num_threads(),
+               "parallel_for_each_thread: need 1 to {} parts (the threads), got {}", num_threads(),
+               parts);
+  if (parts == 1 || g_inside_part) {
+    for (int i = 0; i < parts; ++i) part(i);
+    return;
+  }
+  pool()->run(parts, part, /*pinned=*/true);
 }
 
 RowBlock row_block(Eigen::Index rows, int parts, int i) {
@@ -196,7 +233,7 @@ RowBlock element_block(Eigen::Index n, int parts, int i) {
 int parts_for(Eigen::Index rows, Eigen::Index min_rows) {
   const Eigen::Index by_size =
       std::max<Eigen::Index>(1, rows / std::max<Eigen::Index>(min_rows, 1));
-  return int(std::min<Eigen::Index>(num_threads(), by_size));
+  return int(std::min<Eigen::Index>(available_threads(), by_size));
 }
 
 }  // namespace hnn::ad

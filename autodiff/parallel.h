@@ -12,6 +12,11 @@ namespace hnn::ad {
 /// Threads the fused kernels may use (default: the hardware's, at most 8). n >= 1.
 void set_num_threads(int n);
 int num_threads();
+/// The threads an op may split its work over here: num_threads(), or 1 inside a part of
+/// parallel_for, whose nested calls run in turn on the part's thread (splitting there would only
+/// add the pieces' partial sums). A step split by rows (nn/row_split.h) thus runs each block as
+/// one thread would.
+int available_threads();
 
 /// A non-owning callable void(int): no allocation, unlike std::function.
 class PartFn {
@@ -36,6 +41,13 @@ class PartFn {
 /// 65,535 parts run the same parts serially: the split (and so every result, bit for bit)
 /// depends only on `parts`.
 void parallel_for(int parts, PartFn part);
+
+/// parallel_for with part i on the pool's thread i (the caller's is 0): each thread runs the same
+/// part every time, so the buffers it keeps for that part (its tape, its scratch) keep their
+/// shapes from call to call (Note [Pinned parts] in parallel.cpp). For a few long parts: the
+/// caller waits for a worker that is slow to wake instead of running its part. parts <=
+/// num_threads(). Nested and concurrent calls run serially, as parallel_for's do.
+void parallel_for_each_thread(int parts, PartFn part);
 
 /// Row block i of `parts` equal blocks of `rows`: [begin, end).
 struct RowBlock {
@@ -65,12 +77,12 @@ inline constexpr Eigen::Index kParallelElements = Eigen::Index(1) << 15;
 /// bits do not depend on the split.
 template <typename Body>
 void for_element_blocks(Eigen::Index n, const Body& body) {
-  const int parts = n >= kParallelElements ? num_threads() : 1;
+  const int parts = n >= kParallelElements ? available_threads() : 1;
   if (parts == 1) return body(RowBlock{0, n});
   parallel_for(parts, [&](int i) { body(element_block(n, parts, i)); });
 }
 
-/// How many parts a batch of `rows` is worth splitting into: one per thread, but at least
+/// How many parts a batch of `rows` is worth splitting into: one per available thread, but at least
 /// `min_rows` rows each (below that, waking a thread costs more than it saves).
 int parts_for(Eigen::Index rows, Eigen::Index min_rows = 64);
 

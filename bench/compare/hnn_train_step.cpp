@@ -27,6 +27,7 @@
 #include "nn/hnn.h"
 #include "nn/loss.h"
 #include "nn/optim.h"
+#include "nn/row_split.h"
 #include "tasks/experiments/registry.h"
 #include "tasks/field/field_task.h"
 #include "tasks/integrate/integrator_step.h"
@@ -117,7 +118,8 @@ nn::DynamicsConfig dynamics_config(const cmp::Options& o) {
 template <typename T>
 class Model {
  public:
-  explicit Model(const cmp::Options& o)
+  /// `rows`: the training set's (a batch of 0 is all of them).
+  Model(const cmp::Options& o, Eigen::Index rows)
       : rollout_(o.loss == "rollout"),
         l1_(o.norm == "l1"),
         integrator_(hnn::tasks::parse_rollout_integrator(o.integrator)) {
@@ -135,6 +137,10 @@ class Model {
       named_ = dynamics_->named_parameters();
       for (const nn::NamedParameter<T>& p : named_) ae_.push_back(p.var);
     }
+    if (dynamics_) {
+      const int parts = nn::row_split_parts(o.batch > 0 ? o.batch : rows, ad::num_threads());
+      if (parts > 1) split_ = std::make_unique<nn::RowSplit<T>>(*dynamics_, parts);
+    }
     params_ = ae_;
     params_.insert(params_.end(), dyn_.begin(), dyn_.end());
     // The pixel task's groups (PixelConfig): L2 on the autoencoder only.
@@ -150,23 +156,41 @@ class Model {
 
   /// The training loss of a batch (split_parts' layout), on the tape.
   ad::Var<T> loss(const std::vector<ad::Matrix<T>>& parts) const {
-    if (rollout_) return rollout_loss(parts);
-    const ad::Var<T> x = ad::Var<T>::constant(parts[0]);
-    if (pixel_) {
-      return ad::mean(
-          pixel::pixel_loss(*pixel_, x, ad::Var<T>::constant(parts[1]), kHnnWeight).total);
-    }
-    return nn::mse(dynamics_->time_derivative(x), ad::Var<T>::constant(parts[1]));
+    return loss(parts, dynamics_.get(), {0, parts[0].rows()});
   }
 
-  /// One training step: the trainer's loop body. Returns the nodes it recorded on the tape
-  /// (forward and backward: the step's op count).
-  std::size_t step(const std::vector<ad::Matrix<T>>& parts) {
-    ad::TapeScope scope;  // everything this step records is recycled at the closing brace
+  /// The training loss of rows `block` of a batch computed by `model` (the dynamics model or a
+  /// replica of it), as the trainer's objectives give it (tasks/train/objective.h, rows_loss).
+  ad::Var<T> loss(const std::vector<ad::Matrix<T>>& parts, const nn::DynamicsModel<T>* model,
+                  ad::RowBlock block) const {
+    const auto rows = [&](std::size_t k) {
+      return ad::Var<T>::constant(parts[k].middleRows(block.begin, block.size()));
+    };
+    if (rollout_) return rollout_loss(rows, parts.size(), *model);
+    if (pixel_) return ad::mean(pixel::pixel_loss(*pixel_, rows(0), rows(1), kHnnWeight).total);
+    return nn::mse(model->time_derivative(rows(0)), rows(1));
+  }
+
+  /// Nodes one step records on the tape (forward and backward: the step's op count), unsplit.
+  std::size_t tape_nodes(const std::vector<ad::Matrix<T>>& parts) {
+    ad::TapeScope scope;
     const std::size_t mark = ad::Tape<T>::current().size();
-    const ad::Var<T> l = loss(parts);
-    ad::grad_into(l, params_, grads_);
-    const std::size_t nodes = ad::Tape<T>::current().size() - mark;
+    ad::grad_into(loss(parts), params_, grads_);
+    return ad::Tape<T>::current().size() - mark;
+  }
+
+  /// One training step: the trainer's loop body (tasks/train/loop.cpp, train_step), the batch's
+  /// rows split among the threads as the trainer splits them.
+  void step(const std::vector<ad::Matrix<T>>& parts) {
+    ad::TapeScope scope;  // everything this step records is recycled at the closing brace
+    if (split_) {
+      const auto rows_loss = [&](const nn::DynamicsModel<T>& model, ad::RowBlock block) {
+        return loss(parts, &model, block);
+      };
+      split_->loss_and_gradients(parts[0].rows(), rows_loss, grads_);
+    } else {
+      ad::grad_into(loss(parts), params_, grads_);
+    }
     const auto split = std::ptrdiff_t(ae_.size());
     if (adam_dyn_) {
       adam_main_->step({grads_.begin(), grads_.begin() + split});
@@ -174,7 +198,6 @@ class Model {
     } else {
       adam_main_->step(grads_);
     }
-    return nodes;
   }
 
   /// The mean loss over a whole split, without a graph (chunks of 1000 rows).
@@ -204,13 +227,15 @@ class Model {
  private:
   // RolloutObjective's loss: from the start states, one integrator step per window step, the
   // MSE (or mean absolute error) of every reached state, averaged over the steps.
-  ad::Var<T> rollout_loss(const std::vector<ad::Matrix<T>>& parts) const {
-    const std::size_t horizon = (parts.size() - 1) / 2;
-    ad::Var<T> x = ad::Var<T>::constant(parts[0]), total;
+  template <typename Rows>
+  ad::Var<T> rollout_loss(const Rows& rows, std::size_t parts,
+                          const nn::DynamicsModel<T>& model) const {
+    const std::size_t horizon = (parts - 1) / 2;
+    ad::Var<T> x = rows(0), total;
     for (std::size_t j = 0; j < horizon; ++j) {
-      const ad::Var<T> h = ad::Var<T>::constant(parts[1 + horizon + j]);
-      x = hnn::tasks::integrator_step(*dynamics_, x, h, integrator_);
-      const ad::Var<T> target = ad::Var<T>::constant(parts[1 + j]);
+      const ad::Var<T> h = rows(1 + horizon + j);
+      x = hnn::tasks::integrator_step(model, x, h, integrator_);
+      const ad::Var<T> target = rows(1 + j);
       const ad::Var<T> step_loss =
           l1_ ? hnn::tasks::mean_absolute_error(x, target) : nn::mse(x, target);
       total = total.defined() ? total + step_loss : step_loss;
@@ -225,6 +250,7 @@ class Model {
   std::vector<nn::NamedParameter<T>> named_;
   std::vector<ad::Var<T>> ae_, dyn_, params_, grads_;
   std::unique_ptr<nn::Adam<T>> adam_main_, adam_dyn_;
+  std::unique_ptr<nn::RowSplit<T>> split_;  // null: each op splits its own work
 };
 
 // Parameters in torch's layout (a Linear's weight out x in), float64, in hnn's order; and a JSON
@@ -278,25 +304,24 @@ void gather(const std::vector<ad::Matrix<T>>& parts, cmp::BatchIndices& indices,
 
 template <typename T>
 json run(const cmp::Options& o, const cmp::Data& data) {
-  Model<T> model(o);
-  if (!o.save_init.empty()) save_init(model, o.save_init);
   const Parts train = split_parts(o, data.train_x, data.train_dx);
   std::vector<ad::Matrix<T>> parts, batch;
   for (const Batch& p : train) parts.push_back(p.cast<T>());
+  Model<T> model(o, parts[0].rows());
+  if (!o.save_init.empty()) save_init(model, o.save_init);
   cmp::BatchIndices indices(o.seed, parts[0].rows());
   cmp::StepTimer timer(o.steps, o.warmup, o.window);
-  std::uint64_t gemm_flops = 0;  // of the first (untimed) step
-  std::size_t nodes = 0;         // of the last step
+  std::uint64_t gemm_flops = 0;  // of the first batch, unsplit (before the timing)
+  std::size_t nodes = 0;
   for (int step = 0; step < o.steps; ++step) {
-    std::optional<ad::GemmFlopCounter> counter;
-    if (step == 0) counter.emplace();
-    if (o.batch == 0) {
-      nodes = model.step(parts);
-    } else {
-      gather(parts, indices, o.batch, batch);
-      nodes = model.step(batch);
+    if (o.batch != 0) gather(parts, indices, o.batch, batch);
+    const std::vector<ad::Matrix<T>>& rows = o.batch == 0 ? parts : batch;
+    if (step == 0) {
+      const ad::GemmFlopCounter counter;
+      nodes = model.tape_nodes(rows);
+      gemm_flops = counter.flops();
     }
-    if (counter) gemm_flops = counter->flops();
+    model.step(rows);
     timer.tick(step + 1);
   }
   json result = timer.to_json();

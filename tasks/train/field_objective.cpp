@@ -33,16 +33,29 @@ FieldObjective<T>::FieldObjective(nn::DynamicsModel<T>& model, const Dataset& da
 
 template <typename T>
 ad::Var<T> FieldObjective<T>::batch_loss() {
-  if (!sampler_.full()) {  // into buffers sized once: a step allocates nothing
-    const std::vector<Eigen::Index>& rows = sampler_.rows();
-    for (std::size_t i = 0; i < rows.size(); ++i) {
-      batch_x_.row(Eigen::Index(i)) = x_.row(rows[i]);
-      batch_dxdt_.row(Eigen::Index(i)) = dxdt_.row(rows[i]);
-    }
+  return rows_loss(model_, {0, gather_batch()});
+}
+
+template <typename T>
+Eigen::Index FieldObjective<T>::gather_batch() {
+  if (sampler_.full()) return x_.rows();
+  const std::vector<Eigen::Index>& rows = sampler_.rows();  // into buffers sized once
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    batch_x_.row(Eigen::Index(i)) = x_.row(rows[i]);
+    batch_dxdt_.row(Eigen::Index(i)) = dxdt_.row(rows[i]);
   }
+  return batch_x_.rows();
+}
+
+template <typename T>
+ad::Var<T> FieldObjective<T>::rows_loss(const nn::DynamicsModel<T>& model,
+                                        ad::RowBlock block) const {
   const bool full = sampler_.full();
-  return nn::mse(model_.time_derivative(ad::Var<T>::constant(full ? x_ : batch_x_)),
-                 ad::Var<T>::constant(full ? dxdt_ : batch_dxdt_));
+  const auto rows = [&](const ad::Matrix<T>& m) {
+    return ad::Var<T>::constant(m.middleRows(block.begin, block.size()));
+  };
+  return nn::mse(model.time_derivative(rows(full ? x_ : batch_x_)),
+                 rows(full ? dxdt_ : batch_dxdt_));
 }
 
 template <typename T>

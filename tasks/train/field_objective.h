@@ -24,6 +24,9 @@ class FieldObjective : public Objective<T> {
   }
   RowSampler& sampler() override { return sampler_; }
   ad::Var<T> batch_loss() override;
+  const nn::DynamicsModel<T>* row_model() const override { return &model_; }
+  Eigen::Index gather_batch() override;
+  ad::Var<T> rows_loss(const nn::DynamicsModel<T>& model, ad::RowBlock block) const override;
   CurvePoint curve_point(long step, double batch_loss) const override;
   std::uint64_t data_fingerprint() const override { return fingerprint(data_); }
 

@@ -2,13 +2,16 @@
 
 #include <chrono>
 #include <cmath>
+#include <memory>
 #include <numbers>
 #include <optional>
 #include <stdexcept>
 
 #include "autodiff/check.h"
 #include "autodiff/grad.h"
+#include "autodiff/parallel.h"
 #include "autodiff/tape.h"
+#include "nn/row_split.h"
 #include "tasks/error.h"
 #include "tasks/train/checkpoint.h"
 #include "tasks/train/progress.h"
@@ -103,22 +106,42 @@ auto unless_the_field_fails(long step, const char* on, const std::string& where,
   }
 }
 
-// One step: the batch's loss, its gradients and the optimiser's update. Returns the loss.
+// One step: the batch's loss, its gradients and the optimiser's update. Returns the loss. With
+// `split`, the batch's rows are shared among the engine's threads, each with its own replica of
+// the model (nn/row_split.h); without, each op splits its own work.
 template <typename T>
-double train_step(long step, Objective<T>& objective, nn::Adam<T>& adam,
+double train_step(long step, Objective<T>& objective, nn::RowSplit<T>* split, nn::Adam<T>& adam,
                   std::vector<ad::Var<T>>& grads, const std::string& where) {
   ad::TapeScope scope;  // everything this step records is recycled at the closing brace
   objective.sampler().next();
-  const ad::Var<T> loss =
-      unless_the_field_fails(step, "the batch", where, [&] { return objective.batch_loss(); });
-  const double value = double(loss.item());
+  ad::Var<T> loss;  // of the unsplit step
+  const double value = unless_the_field_fails(step, "the batch", where, [&] {
+    if (split) {
+      const auto rows_loss = [&](const nn::DynamicsModel<T>& model, ad::RowBlock block) {
+        return objective.rows_loss(model, block);
+      };
+      return split->loss_and_gradients(objective.gather_batch(), rows_loss, grads);
+    }
+    loss = objective.batch_loss();
+    return double(loss.item());
+  });
   if (!std::isfinite(value)) {
     throw TrainingDiverged(
         fmt::format("training diverged at step {}: the loss is {}{}", step, value, where), step);
   }
-  ad::grad_into(loss, adam.parameters(), grads);
+  if (loss.defined()) ad::grad_into(loss, adam.parameters(), grads);
   adam.step(grads);
   return value;
+}
+
+// The row split of an objective's steps at the engine's thread count, or nothing when its loss
+// does not split by rows or its batches are too small to share.
+template <typename T>
+std::unique_ptr<nn::RowSplit<T>> row_split(Objective<T>& objective) {
+  const nn::DynamicsModel<T>* model = objective.row_model();
+  if (model == nullptr) return nullptr;
+  const int parts = nn::row_split_parts(objective.sampler().batch_size(), ad::num_threads());
+  return parts > 1 ? std::make_unique<nn::RowSplit<T>>(*model, parts) : nullptr;
 }
 
 // One run of the loop: the optimiser, the checkpoints, the loss curve so far and the clock.
@@ -132,6 +155,7 @@ class Loop {
         checkpoints_(o.checkpoint_dir, o.checkpoint_every, o.steps, o.run_settings,
                      objective.data_fingerprint(), o.checkpoint_steps) {
     check_groups(objective, adam_.parameters());
+    split_ = row_split(objective);
     for (std::size_t g = 0; g < adam_.group_count(); ++g) base_lr_.push_back(adam_.options(g).lr);
   }
 
@@ -154,7 +178,7 @@ class Loop {
       const double factor = lr_factor(o_.lr_schedule, step, o_.steps);
       for (std::size_t g = 0; g < base_lr_.size(); ++g) adam_.set_lr(g, base_lr_[g] * factor);
     }
-    return train_step(step, objective_, adam_, grads_, checkpoints_.last_good());
+    return train_step(step, objective_, split_.get(), adam_, grads_, checkpoints_.last_good());
   }
 
   void record(long step, double loss) {
@@ -191,7 +215,8 @@ class Loop {
   Objective<T>& objective_;
   const LoopOptions& o_;
   nn::Adam<T> adam_;
-  std::vector<double> base_lr_;  // each group's configured rate, which a schedule scales
+  std::unique_ptr<nn::RowSplit<T>> split_;  // null: each op splits its own work
+  std::vector<double> base_lr_;             // each group's configured rate, which a schedule scales
   RunCheckpoints<T> checkpoints_;
   const long interval_ = record_interval(o_);
   TrainResult result_;

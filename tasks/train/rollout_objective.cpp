@@ -177,8 +177,8 @@ RolloutObjective<T>::RolloutObjective(nn::DynamicsModel<T>& model, RolloutWindow
       scratch_(1 + 2 * train_.next.size()) {}
 
 template <typename T>
-ad::Var<T> RolloutObjective<T>::constant_rows(const Batch& m, const std::vector<Eigen::Index>* rows,
-                                              double scale, std::size_t slot) const {
+void RolloutObjective<T>::gather_rows(const Batch& m, const std::vector<Eigen::Index>* rows,
+                                      double scale, std::size_t slot) const {
   ad::Matrix<T>& out = scratch_[slot];
   const Eigen::Index n = rows == nullptr ? m.rows() : Eigen::Index(rows->size());
   out.resize(n, m.cols());  // no allocation once the size has been seen
@@ -188,30 +188,49 @@ ad::Var<T> RolloutObjective<T>::constant_rows(const Batch& m, const std::vector<
     for (Eigen::Index i = 0; i < n; ++i)
       out.row(i) = (m.row((*rows)[std::size_t(i)]) * scale).template cast<T>();
   }
-  return ad::Var<T>::constant(out);
+}
+
+template <typename T>
+Eigen::Index RolloutObjective<T>::gather(const RolloutWindows& w,
+                                         const std::vector<Eigen::Index>* rows) const {
+  horizon_ = w.next.size();
+  if (scratch_.size() < 1 + 2 * horizon_) scratch_.resize(1 + 2 * horizon_);
+  gather_rows(w.start, rows, 1.0, 0);
+  for (std::size_t j = 0; j < horizon_; ++j) {
+    gather_rows(w.step[j], rows, 1.0 / substeps_, 1 + 2 * j);
+    gather_rows(w.next[j], rows, 1.0, 2 + 2 * j);
+  }
+  return scratch_[0].rows();
 }
 
 // `substeps_` steps of the integrator per sampling interval, each row with its own length.
 template <typename T>
-ad::Var<T> RolloutObjective<T>::loss(const RolloutWindows& w,
-                                     const std::vector<Eigen::Index>* rows) const {
-  if (scratch_.size() < 1 + 2 * w.next.size()) scratch_.resize(1 + 2 * w.next.size());
-  ad::Var<T> x = constant_rows(w.start, rows, 1.0, 0);
+ad::Var<T> RolloutObjective<T>::rows_loss(const nn::DynamicsModel<T>& model,
+                                          ad::RowBlock block) const {
+  const auto rows = [&](std::size_t slot) {
+    return ad::Var<T>::constant(scratch_[slot].middleRows(block.begin, block.size()));
+  };
+  ad::Var<T> x = rows(0);
   ad::Var<T> total;
-  for (std::size_t j = 0; j < w.next.size(); ++j) {
-    const ad::Var<T> h = constant_rows(w.step[j], rows, 1.0 / substeps_, 1 + 2 * j);
-    for (int s = 0; s < substeps_; ++s) x = integrator_step(model_, x, h, integrator_);
-    const ad::Var<T> target = constant_rows(w.next[j], rows, 1.0, 2 + 2 * j);
+  for (std::size_t j = 0; j < horizon_; ++j) {
+    const ad::Var<T> h = rows(1 + 2 * j);
+    for (int s = 0; s < substeps_; ++s) x = integrator_step(model, x, h, integrator_);
+    const ad::Var<T> target = rows(2 + 2 * j);
     const ad::Var<T> step_loss =
         norm_ == RolloutNorm::kL1 ? mean_absolute_error(x, target) : nn::mse(x, target);
     total = total.defined() ? total + step_loss : step_loss;
   }
-  return total * T(1.0 / double(w.next.size()));
+  return total * T(1.0 / double(horizon_));
 }
 
 template <typename T>
 ad::Var<T> RolloutObjective<T>::batch_loss() {
-  return loss(train_, sampler_.full() ? nullptr : &sampler_.rows());
+  return rows_loss(model_, {0, gather_batch()});
+}
+
+template <typename T>
+Eigen::Index RolloutObjective<T>::gather_batch() {
+  return gather(train_, sampler_.full() ? nullptr : &sampler_.rows());
 }
 
 template <typename T>
@@ -225,13 +244,12 @@ CurvePoint RolloutObjective<T>::curve_point(long step, double batch_loss) const 
   ad::TapeScope scope;
   ad::NoGradGuard values_only;
   const std::vector<Eigen::Index> train_rows = at_most(train_);
-  const double train =
-      sampler_.full() ? batch_loss : double(loss(train_, &train_rows).value()(0, 0));
+  const auto loss_of = [&](const RolloutWindows& w, const std::vector<Eigen::Index>& rows) {
+    return double(rows_loss(model_, {0, gather(w, &rows)}).item());
+  };
+  const double train = sampler_.full() ? batch_loss : loss_of(train_, train_rows);
   double test = NAN;
-  if (test_.count() > 0) {
-    const std::vector<Eigen::Index> test_rows = at_most(test_);
-    test = double(loss(test_, &test_rows).value()(0, 0));
-  }
+  if (test_.count() > 0) test = loss_of(test_, at_most(test_));
   return {step, train, test};
 }
 

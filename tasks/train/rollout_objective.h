@@ -91,18 +91,23 @@ class RolloutObjective : public Objective<T> {
   }
   RowSampler& sampler() override { return sampler_; }
   ad::Var<T> batch_loss() override;
+  const nn::DynamicsModel<T>* row_model() const override { return &model_; }
+  Eigen::Index gather_batch() override;
+  /// The mean squared (or absolute) error of the predicted states over every step of the
+  /// gathered windows' rows `block`.
+  ad::Var<T> rows_loss(const nn::DynamicsModel<T>& model, ad::RowBlock block) const override;
   CurvePoint curve_point(long step, double batch_loss) const override;
   std::uint64_t data_fingerprint() const override;
 
  private:
-  // The mean squared (or absolute) error of the predicted states over every step of `rows` of
-  // `w`.
-  ad::Var<T> loss(const RolloutWindows& w, const std::vector<Eigen::Index>* rows) const;
+  // The windows `rows` of `w` (all with nullptr) into scratch_: start states, then each step's
+  // length (divided by the substeps) and target. Returns their count.
+  Eigen::Index gather(const RolloutWindows& w, const std::vector<Eigen::Index>* rows) const;
 
-  // The rows of `m` picked by `rows` (all with nullptr), scaled, as a tape constant; gathered in
-  // scratch that persists, so a warmed-up step allocates nothing.
-  ad::Var<T> constant_rows(const Batch& m, const std::vector<Eigen::Index>* rows, double scale,
-                           std::size_t slot) const;
+  // The rows of `m` picked by `rows` (all with nullptr), scaled, into scratch_[slot], which
+  // persists: a warmed-up step allocates nothing.
+  void gather_rows(const Batch& m, const std::vector<Eigen::Index>* rows, double scale,
+                   std::size_t slot) const;
 
   nn::DynamicsModel<T>& model_;
   RolloutWindows train_, test_;
@@ -111,7 +116,8 @@ class RolloutObjective : public Objective<T> {
   RolloutIntegrator integrator_;
   int substeps_;
   RolloutNorm norm_;
-  mutable std::vector<ad::Matrix<T>> scratch_;
+  mutable std::vector<ad::Matrix<T>> scratch_;  // the gathered windows (gather's layout)
+  mutable std::size_t horizon_ = 0;             // of the gathered windows
 };
 
 }  // namespace hnn::tasks

@@ -29,6 +29,8 @@ class RowSampler {
   void next();
   /// The current batch's row indices in [0, rows).
   const std::vector<Eigen::Index>& rows() const { return batch_; }
+  /// Rows per batch (every row for the full batch).
+  Eigen::Index batch_size() const { return full_ ? rows_ : Eigen::Index(batch_.size()); }
 
   /// The generator's state (and the shuffle's order), as text for a checkpoint.
   std::string state() const;

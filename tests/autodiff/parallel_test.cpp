@@ -13,6 +13,8 @@
 #include <thread>
 #include <vector>
 
+#include "autodiff/check.h"
+
 namespace ad = hnn::ad;
 
 namespace {
@@ -81,6 +83,45 @@ TEST(ParallelFor, RethrowsTheLowestFailingPartsException) {
     }
   }
   EXPECT_EQ(WrongCounts(100, 2), 0) << "the pool works after failed jobs";
+}
+
+// Pinned jobs (Note [Pinned parts]): part i on the same thread every time, part 0 on the caller,
+// each part once, mixed with claimed jobs; nested calls run serially; too many parts refused.
+TEST(ParallelForEachThread, RunsPartIOnThreadIEveryTime) {
+  for (int threads : {2, 4}) {
+    ad::set_num_threads(threads);
+    std::vector<std::thread::id> first(static_cast<std::size_t>(threads));
+    std::vector<std::atomic<int>> runs(static_cast<std::size_t>(threads));
+    int wrong = 0;
+    for (int job = 0; job < 3000; ++job) {
+      const int parts = job % 3 == 0 ? threads : 1 + job % threads;
+      for (int i = 0; i < parts; ++i) runs[std::size_t(i)].store(0);
+      std::vector<std::thread::id> seen(static_cast<std::size_t>(parts));
+      ad::parallel_for_each_thread(parts, [&](int i) {
+        Busy();
+        seen[std::size_t(i)] = std::this_thread::get_id();
+        runs[std::size_t(i)].fetch_add(1);
+      });
+      for (int i = 0; i < parts; ++i) {
+        wrong += runs[std::size_t(i)].load() != 1;
+        if (first[std::size_t(i)] == std::thread::id())
+          first[std::size_t(i)] = seen[std::size_t(i)];
+        wrong += seen[std::size_t(i)] != first[std::size_t(i)];
+      }
+      wrong += seen[0] != std::this_thread::get_id();
+      if (job % 7 == 0) wrong += WrongCounts(3, threads);  // claimed jobs in between
+    }
+    EXPECT_EQ(wrong, 0) << threads << " threads";
+    EXPECT_THROW(ad::parallel_for_each_thread(threads + 1, [](int) {}), ad::Error);
+  }
+  ad::set_num_threads(2);
+  std::atomic<int> inner{0};
+  ad::parallel_for_each_thread(2, [&](int) {
+    EXPECT_EQ(ad::available_threads(), 1);
+    ad::parallel_for_each_thread(2, [&](int) { inner.fetch_add(1); });  // nested: serial
+  });
+  EXPECT_EQ(inner.load(), 4);
+  EXPECT_EQ(ad::available_threads(), 2);
 }
 
 // Element blocks tile [0, n) in order and start at whole 16-element packets.
