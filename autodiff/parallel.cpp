@@ -17,6 +17,7 @@ namespace hnn::ad {
 namespace {
 
 thread_local bool g_inside_part = false;
+std::atomic<long> g_stolen{0};  // pinned parts the caller ran for a worker (Note [Pinned parts])
 
 // Note [Claimed parts]: a job's parts are claimed one at a time from one atomic word, by the
 // caller and by every worker that wakes while parts are left; the caller, once nothing is left
@@ -31,11 +32,15 @@ thread_local bool g_inside_part = false;
 // go to whoever gets there first, so from one call to the next a thread may run another part;
 // where parts keep buffers per thread (a step split by rows: each thread's tape) and the parts'
 // sizes differ by a row, every swap resized those buffers, allocating in steady state. A pinned
-// job is published with all its parts claimed; each worker whose index is below the parts runs
-// its own once, and the caller runs part 0.
+// job is published with all its parts claimed; each worker whose index is below the parts starts
+// its own, and the caller runs part 0. A part is started once, by whoever marks it first: the
+// caller, done with part 0, starts any part whose worker has not (a worker the host has not
+// scheduled would otherwise hold the whole job up, and the split would lose to one thread).
+// Parts taken so are counted (stolen_parts()); they resize buffers as claimed parts did.
 class Pool {
  public:
-  explicit Pool(int threads) : errors_(std::size_t(threads)) {  // a step's jobs: no allocation
+  explicit Pool(int threads)  // sized once: a step's jobs allocate nothing
+      : errors_(std::size_t(threads)), started_(std::make_unique<std::atomic<bool>[]>(threads)) {
     for (int i = 1; i < threads; ++i) workers_.emplace_back([this, i] { work(i); });
   }
   ~Pool() {
@@ -54,6 +59,7 @@ class Pool {
     if (errors_.size() < std::size_t(parts)) errors_.resize(std::size_t(parts));
     std::fill_n(errors_.begin(), parts, nullptr);
     done_.store(0, std::memory_order_relaxed);
+    for (int i = 0; pinned && i < parts; ++i) started_[i].store(i == 0, std::memory_order_relaxed);
     generation_ += kGeneration;
     // Publishes the job (release: job_ and the reset counters are visible to whoever claims). A
     // pinned job is published with every part claimed.
@@ -63,6 +69,12 @@ class Pool {
     claim_.notify_all();
     if (pinned) {
       run_part(0, parts);
+      for (int i = 1; i < parts; ++i) {
+        if (start(i)) {
+          g_stolen.fetch_add(1, std::memory_order_relaxed);
+          run_part(i, parts);
+        }
+      }
     } else {
       for (int i = claim().part; i >= 0; i = claim().part) run_part(i, parts);
     }
@@ -87,6 +99,9 @@ class Pool {
   static void serial(int parts, PartFn part) {
     for (int i = 0; i < parts; ++i) part(i);
   }
+
+  // Marks part i of a pinned job started; false when someone already had.
+  bool start(int i) { return !started_[i].exchange(true, std::memory_order_acq_rel); }
 
   struct Claimed {
     int part = -1;           // -1: every part of the current job is claimed
@@ -129,7 +144,7 @@ class Pool {
       const int parts = int((c.word >> kPartsShift) & kField);
       if ((c.word & kPinned) && generation != ran && index < parts) {
         ran = generation;
-        run_part(index, parts);
+        if (start(index)) run_part(index, parts);
         continue;  // the caller may have published the next job meanwhile
       }
       if (!spin_until_changed(c.word)) claim_.wait(c.word);  // until a new job or ~Pool
@@ -169,6 +184,7 @@ class Pool {
   std::atomic<bool> stop_{false};
   std::uint64_t generation_ = 0;  // the caller's copy (under busy_)
   const PartFn* job_ = nullptr;
+  std::unique_ptr<std::atomic<bool>[]> started_;  // per part of a pinned job
 };
 
 int default_threads() {
@@ -197,6 +213,8 @@ void set_num_threads(int n) {
 }
 
 int num_threads() { return g_threads.load(std::memory_order_relaxed); }
+
+long stolen_parts() { return g_stolen.load(std::memory_order_relaxed); }
 
 int available_threads() { return g_inside_part ? 1 : num_threads(); }
 

@@ -44,10 +44,13 @@ void parallel_for(int parts, PartFn part);
 
 /// parallel_for with part i on the pool's thread i (the caller's is 0): each thread runs the same
 /// part every time, so the buffers it keeps for that part (its tape, its scratch) keep their
-/// shapes from call to call (Note [Pinned parts] in parallel.cpp). For a few long parts: the
-/// caller waits for a worker that is slow to wake instead of running its part. parts <=
-/// num_threads(). Nested and concurrent calls run serially, as parallel_for's do.
+/// shapes from call to call (Note [Pinned parts] in parallel.cpp). A part whose worker has not
+/// started it by the time the caller finishes part 0 is run by the caller (stolen_parts() counts
+/// them). For a few long parts; parts <= num_threads(). Nested and concurrent calls run serially,
+/// as parallel_for's do.
 void parallel_for_each_thread(int parts, PartFn part);
+/// Parts of parallel_for_each_thread that the caller ran for a late worker, since the start.
+long stolen_parts();
 
 /// Row block i of `parts` equal blocks of `rows`: [begin, end).
 struct RowBlock {

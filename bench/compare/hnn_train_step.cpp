@@ -327,6 +327,7 @@ json run(const cmp::Options& o, const cmp::Data& data) {
   json result = timer.to_json();
   result["gemm_flops_per_step"] = gemm_flops;
   result["tape_nodes_per_step"] = nodes;
+  result["stolen_parts"] = ad::stolen_parts();  // row-split parts the caller ran for a late worker
   result["train_loss"] = model.mean_loss(train);
   result["test_loss"] = model.mean_loss(split_parts(o, data.test_x, data.test_dx));
   result["train_rows"] = parts[0].rows();  // windows, for the rollout loss

@@ -85,12 +85,14 @@ TEST(ParallelFor, RethrowsTheLowestFailingPartsException) {
   EXPECT_EQ(WrongCounts(100, 2), 0) << "the pool works after failed jobs";
 }
 
-// Pinned jobs (Note [Pinned parts]): part i on the same thread every time, part 0 on the caller,
-// each part once, mixed with claimed jobs; nested calls run serially; too many parts refused.
-TEST(ParallelForEachThread, RunsPartIOnThreadIEveryTime) {
+// Pinned jobs (Note [Pinned parts]): part 0 on the caller, part i on thread i unless the caller
+// found it not started and ran it itself (never on another worker), each part once, mixed with
+// claimed jobs; nested calls run serially; too many parts refused.
+TEST(ParallelForEachThread, RunsPartIOnThreadIOrOnTheCaller) {
   for (int threads : {2, 4}) {
     ad::set_num_threads(threads);
-    std::vector<std::thread::id> first(static_cast<std::size_t>(threads));
+    const std::thread::id caller = std::this_thread::get_id();
+    std::vector<std::thread::id> worker(static_cast<std::size_t>(threads));
     std::vector<std::atomic<int>> runs(static_cast<std::size_t>(threads));
     int wrong = 0;
     for (int job = 0; job < 3000; ++job) {
@@ -102,14 +104,21 @@ TEST(ParallelForEachThread, RunsPartIOnThreadIEveryTime) {
         seen[std::size_t(i)] = std::this_thread::get_id();
         runs[std::size_t(i)].fetch_add(1);
       });
+      wrong += seen[0] != caller;
       for (int i = 0; i < parts; ++i) {
         wrong += runs[std::size_t(i)].load() != 1;
-        if (first[std::size_t(i)] == std::thread::id())
-          first[std::size_t(i)] = seen[std::size_t(i)];
-        wrong += seen[std::size_t(i)] != first[std::size_t(i)];
+        const std::thread::id id = seen[std::size_t(i)];
+        if (i == 0 || id == caller) continue;
+        if (worker[std::size_t(i)] == std::thread::id()) worker[std::size_t(i)] = id;
+        wrong += id != worker[std::size_t(i)];
       }
-      wrong += seen[0] != std::this_thread::get_id();
       if (job % 7 == 0) wrong += WrongCounts(3, threads);  // claimed jobs in between
+    }
+    for (int i = 1; i < threads; ++i) {
+      for (int j = i + 1; j < threads; ++j) {
+        const bool both = worker[std::size_t(i)] != std::thread::id();
+        wrong += both && worker[std::size_t(i)] == worker[std::size_t(j)];
+      }
     }
     EXPECT_EQ(wrong, 0) << threads << " threads";
     EXPECT_THROW(ad::parallel_for_each_thread(threads + 1, [](int) {}), ad::Error);
