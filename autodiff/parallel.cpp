@@ -218,24 +218,29 @@ long stolen_parts() { return g_stolen.load(std::memory_order_relaxed); }
 
 int available_threads() { return g_inside_part ? 1 : num_threads(); }
 
-void parallel_for(int parts, PartFn part) {
-  HNN_AD_CHECK(parts >= 1, "parallel_for: need at least 1 part, got {}", parts);
+namespace {
+
+// A job on the pool; one part, or a call nested in a part, runs in turn on this thread.
+void dispatch(int parts, PartFn part, bool pinned) {
   if (parts == 1 || g_inside_part) {
     for (int i = 0; i < parts; ++i) part(i);
     return;
   }
-  pool()->run(parts, part, /*pinned=*/false);
+  pool()->run(parts, part, pinned);
+}
+
+}  // namespace
+
+void parallel_for(int parts, PartFn part) {
+  HNN_AD_CHECK(parts >= 1, "parallel_for: need at least 1 part, got {}", parts);
+  dispatch(parts, part, /*pinned=*/false);
 }
 
 void parallel_for_each_thread(int parts, PartFn part) {
   HNN_AD_CHECK(parts >= 1 && parts <= num_threads(),
                "parallel_for_each_thread: need 1 to {} parts (the threads), got {}", num_threads(),
                parts);
-  if (parts == 1 || g_inside_part) {
-    for (int i = 0; i < parts; ++i) part(i);
-    return;
-  }
-  pool()->run(parts, part, /*pinned=*/true);
+  dispatch(parts, part, /*pinned=*/true);
 }
 
 RowBlock row_block(Eigen::Index rows, int parts, int i) {

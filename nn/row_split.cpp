@@ -32,12 +32,10 @@ RowSplit<T>::RowSplit(const DynamicsModel<T>& model, int parts)
       weighed_(std::size_t(parts_)),
       losses_(std::size_t(parts_)) {
   params_[0] = model.parameters();
+  for (const ad::Var<T>& w : params_[0]) sums_.push_back(ad::Var<T>::leaf(w.value(), false));
   for (int p = 1; p < parts_; ++p) {
     replicas_.push_back(cast_model<T>(model));
     params_[std::size_t(p)] = replicas_.back()->parameters();
-  }
-  for (const ad::Var<T>& w : params_[0]) sums_.push_back(ad::Var<T>::leaf(w.value(), false));
-  for (int p = 1; p < parts_; ++p) {
     for (const ad::Var<T>& w : params_[0]) weighed_[std::size_t(p)].push_back(w.value());
   }
 }
