@@ -145,6 +145,28 @@ class Sweep : public GradSink<T> {
     accumulate(in.slot, g);
   }
 
+  // Note [Sums added into in place]: a weight that a rollout's 16 field evaluations reach got,
+  // from each, a fresh product zeroed by the GEMM and then added into the sum here, two passes
+  // over the weight's size per evaluation; the fused MLP kernels add their products into the sum
+  // itself instead.
+  Matrix<T>* sum_into(int i) override {
+    if (grad_enabled() || !wants(i)) return nullptr;
+    const Node<T>& in = current_->inputs[i].node();
+    Var<T>& acc = grads_[in.slot];
+    if (!owned_[in.slot]) {
+      Node<T>& sum = Tape<T>::current().push();
+      sum.op = "grad_sum";
+      if (acc.defined()) {
+        sum.value = acc.value();
+      } else {
+        sum.value.setZero(in.value.rows(), in.value.cols());
+      }
+      acc = Var<T>::of(sum);
+      owned_[in.slot] = 1;
+    }
+    return &acc.node().value;
+  }
+
  private:
   bool is_target(const Node<T>* node) const {
     if (all_leaves_ && node->is_leaf) return true;

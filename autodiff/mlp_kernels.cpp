@@ -55,14 +55,26 @@ struct PartSpace {
   // partial weight and bias gradients, hbar_k, and the gradient propagated to layer k.
   std::vector<Matrix<T>> dw, db, hbar, grad;
   Matrix<T> sums;  // a row of column sums, before it goes into a column of dW_L
+  // Per layer: the sweep's gradient sum that the weight's products are added into (Note [Sums
+  // added into in place] in grad.cpp), or null for the partial dw; and the next product's beta.
+  std::vector<Matrix<T>*> dw_sum;
+  std::vector<T> dw_beta;
   void size_for(int layers) {
     if (int(dw.size()) < layers) {
       dw.resize(std::size_t(layers));
       db.resize(std::size_t(layers));
       hbar.resize(std::size_t(layers));
       grad.resize(std::size_t(layers));
+      dw_sum.resize(std::size_t(layers));
+      dw_beta.resize(std::size_t(layers));
     }
   }
+  Matrix<T>& weight_gradient(int k) {
+    Matrix<T>* sum = dw_sum[std::size_t(k)];
+    return sum ? *sum : dw[std::size_t(k)];
+  }
+  // beta for the next product into layer k's weight gradient: 0 for a partial's first.
+  T take_beta(int k) { return std::exchange(dw_beta[std::size_t(k)], T(1)); }
 };
 
 template <typename T>
@@ -106,13 +118,32 @@ void add_reduced(std::vector<PartSpace<T>>& space, int parts,
   s.add(input, Var<T>::of(g));
 }
 
+// Where each part's weight gradients go. With one part, the products of layers 1 .. last add
+// into the sweep's sums when it allows (a values-only sweep): no partial to zero and hand on.
+// Otherwise into the parts' partials, each sized for its first product (beta 0).
+template <typename T>
+void route_weight_gradients(const MlpLayers<T>& l, std::vector<PartSpace<T>>& space, int parts,
+                            int last, GradSink<T>& s) {
+  for (int p = 0; p < parts; ++p) {
+    PartSpace<T>& w = space[std::size_t(p)];
+    for (int k = 1; k <= l.count(); ++k) {
+      const int wi = l.weight_input(k);
+      Matrix<T>* sum = parts == 1 && k <= last && s.wants(wi) ? s.sum_into(wi) : nullptr;
+      w.dw_sum[std::size_t(k)] = sum;
+      w.dw_beta[std::size_t(k)] = sum ? T(1) : T(0);
+      if (!sum) w.dw[std::size_t(k)].resize(l.w(k).rows(), l.w(k).cols());
+    }
+  }
+}
+
 // Sums the parts' partial weight and bias gradients into gradient nodes and hands them on.
 template <typename T>
 void reduce_parameters(const MlpLayers<T>& l, std::vector<PartSpace<T>>& space, int parts,
                        GradSink<T>& s, const char* op) {
   for (int k = 1; k <= l.count(); ++k) {
     const int wi = l.weight_input(k), bi = l.bias_input(k);
-    if (s.wants(wi)) add_reduced(space, parts, &PartSpace<T>::dw, k, wi, s, op);
+    const bool added = space[0].dw_sum[std::size_t(k)] != nullptr;
+    if (!added && s.wants(wi)) add_reduced(space, parts, &PartSpace<T>::dw, k, wi, s, op);
     if (bi >= 0 && s.wants(bi)) add_reduced(space, parts, &PartSpace<T>::db, k, bi, s, op);
   }
 }
@@ -141,8 +172,7 @@ void backprop_rows(const MlpLayers<T>& l, const Node<T>& n, const Var<T>& g, Par
   for (int k = l.count(); k >= 1; --k) {
     const auto prev = hidden_block(l, n.buffers, k - 1, r);
     if (params) {
-      w.dw[std::size_t(k)].resize(prev.cols(), delta->cols());
-      gemm(prev, true, *delta, false, w.dw[std::size_t(k)]);
+      gemm(prev, true, *delta, false, w.weight_gradient(k), w.take_beta(k));
       if (l.bias_input(k) >= 0) {
         w.db[std::size_t(k)].resize(1, delta->cols());
         column_sums(*delta, w.db[std::size_t(k)]);
@@ -175,7 +205,6 @@ void up_the_gradient_chain(const MlpLayers<T>& l, const Node<T>& n, const Var<T>
                            PartSpace<T>& w, RowBlock r, bool params) {
   const GradientBuffers at{l.count(), l.outputs()};
   const Index in = l.x().cols();
-  const T beta = j == 0 ? T(0) : T(1);
   Matrix<T>* abar = &w.grad[0];
   *abar = g.value().block(r.begin, j * in, r.size(), in);
   for (int k = 1; k < l.count(); ++k) {
@@ -184,8 +213,7 @@ void up_the_gradient_chain(const MlpLayers<T>& l, const Node<T>& n, const Var<T>
     dbar->resize(abar->rows(), l.w(k).cols());
     gemm(*abar, false, l.w(k), false, *dbar);
     if (params) {
-      w.dw[std::size_t(k)].resize(abar->cols(), l.w(k).cols());  // kept by later outputs
-      gemm(*abar, true, rows_of(n, at.d(k, j), r), false, w.dw[std::size_t(k)], beta);
+      gemm(*abar, true, rows_of(n, at.d(k, j), r), false, w.weight_gradient(k), w.take_beta(k));
     }
     Matrix<T>& hbar = w.hbar[std::size_t(k)];
     hbar.resize(dbar->rows(), dbar->cols());
@@ -199,7 +227,6 @@ void up_the_gradient_chain(const MlpLayers<T>& l, const Node<T>& n, const Var<T>
     abar = dbar;
   }
   if (!params) return;
-  w.dw[std::size_t(l.count())].resize(abar->cols(), at.columns);
   // Summed into a contiguous row first: added straight into the column (a stride of m
   // elements), the sum did not vectorise and cost as much as a GEMM's packing.
   w.sums.resize(1, abar->cols());
@@ -217,7 +244,8 @@ void down_the_forward_chain(const MlpLayers<T>& l, const Node<T>& n, PartSpace<T
   for (int k = l.count() - 1; k >= 1; --k) {
     hb->array() *= T(1) - rows_of(n, at.h(k), r).array().square();
     if (params) {
-      gemm(hidden_block(l, n.buffers, k - 1, r), true, *hb, false, w.dw[std::size_t(k)], T(1));
+      gemm(hidden_block(l, n.buffers, k - 1, r), true, *hb, false, w.weight_gradient(k),
+           w.take_beta(k));
       if (l.bias_input(k) >= 0) {
         w.db[std::size_t(k)].resize(1, hb->cols());
         column_sums(*hb, w.db[std::size_t(k)]);
@@ -305,12 +333,13 @@ void tanh_mlp_backward_kernel(const Node<T>& n, const Var<T>& g, GradSink<T>& s)
   Node<T>* dx_node = s.wants(0) ? &value_node<T>("tanh_mlp_grad") : nullptr;
   if (dx_node) dx_node->value.resize(rows, l.x().cols());
   const bool params = wants_parameters(l, s);
+  if (params) route_weight_gradients(l, space, parts, l.count(), s);
   parallel_for(parts, [&](int p) {
     backprop_rows(l, n, g, space[std::size_t(p)], row_block(rows, parts, p),
                   dx_node ? &dx_node->value : nullptr, params);
   });
   if (dx_node) s.add(0, Var<T>::of(*dx_node));
-  reduce_parameters(l, space, parts, s, "tanh_mlp_grad");
+  if (params) reduce_parameters(l, space, parts, s, "tanh_mlp_grad");
 }
 
 template <typename T>
@@ -324,6 +353,8 @@ void input_gradient_backward_kernel(const Node<T>& n, const Var<T>& g, GradSink<
   Node<T>* dx_node = wants_dx ? &value_node<T>("tanh_mlp_input_gradient_grad") : nullptr;
   if (dx_node) dx_node->value.resize(rows, l.x().cols());
   const bool params = wants_parameters(l, s);
+  // The last layer's weight gradient is column sums set column by column: a partial.
+  if (params) route_weight_gradients(l, space, parts, l.count() - 1, s);
   parallel_for(parts, [&](int p) {
     const RowBlock r = row_block(rows, parts, p);
     PartSpace<T>& w = space[std::size_t(p)];
@@ -331,7 +362,7 @@ void input_gradient_backward_kernel(const Node<T>& n, const Var<T>& g, GradSink<
     down_the_forward_chain(l, n, w, r, dx_node ? &dx_node->value : nullptr, params);
   });
   if (dx_node) s.add(0, Var<T>::of(*dx_node));
-  reduce_parameters(l, space, parts, s, "tanh_mlp_input_gradient_grad");
+  if (params) reduce_parameters(l, space, parts, s, "tanh_mlp_input_gradient_grad");
 }
 
 #define HNN_INSTANTIATE(T)                                                             \

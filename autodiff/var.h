@@ -148,6 +148,11 @@ class GradSink {
   /// True when the gradient of input `i` is needed by this sweep (skip work otherwise).
   virtual bool wants(int i) const = 0;
   virtual void add(int i, const Var<T>& grad) = 0;
+  /// The sum of input i's gradient so far (zeros when none yet), for a backward to add its
+  /// contribution into in place (a weight gradient's GEMM with beta = 1), or null when it must call
+  /// add: the sweep records its backward, or does not want input i. A matrix given stays the
+  /// input's gradient sum; later adds go into it.
+  virtual Matrix<T>* sum_into(int /*i*/) { return nullptr; }
 };
 
 }  // namespace hnn::ad

@@ -154,6 +154,45 @@ TEST(FusedMlpStep, MatchesTheGenericStepForOneAndTwoThreads) {
   }
 }
 
+// A weight reached by several ops in one sweep: the fused kernels add their products into the
+// sweep's sum in place (Note [Sums added into in place]), whether that sum is still empty, holds
+// another op's gradient, or is already the sweep's own. Either order of the three ops against the
+// same network written with elementary ops.
+TEST(FusedMlpStep, SeveralOpsOnOneWeightSumTheirGradients) {
+  ad::set_num_threads(1);
+  const Layout l{{3, 16, 16, 1}, false};
+  const std::vector<MatrixD> p = parameters(l, 21);
+  for (bool generic_last : {false, true}) {
+    ad::TapeScope scope;
+    std::vector<VarD> vars{VarD::constant(random_matrix(40, 3, 22))};
+    for (const MatrixD& m : p) {
+      if (m.size() > 0) vars.push_back(VarD::leaf(m));
+    }
+    const Net<double> net = net_of(vars, l);
+    const std::vector<VarD> params(vars.begin() + 1, vars.end());
+    std::vector<VarD> xs;
+    for (int i = 0; i < 3; ++i) xs.push_back(VarD::variable(random_matrix(40, 3, 23 + i)));
+    const auto losses = [&](bool fused) {
+      const auto field = [&](const VarD& x) {
+        return fused ? ad::tanh_mlp_input_gradient(x, net.weights, net.biases)
+                     : generic_input_gradient(x, net);
+      };
+      const VarD a = ad::sum(ad::square(field(xs[0])));
+      const VarD middle = generic_last ? field(xs[1]) : generic_mlp(xs[1], net);
+      const VarD last = generic_last ? generic_mlp(xs[2], net) : field(xs[2]);
+      return a + ad::sum(ad::square(middle)) + ad::sum(ad::square(last));
+    };
+    const auto fused = ad::grad<double>({losses(true)}, params);
+    const auto reference = ad::grad<double>({losses(false)}, params);
+    for (std::size_t i = 0; i < params.size(); ++i) {
+      const double scale = reference[i].value().cwiseAbs().maxCoeff();
+      EXPECT_LT((fused[i].value() - reference[i].value()).cwiseAbs().maxCoeff(), 1e-12 * scale)
+          << "parameter " << i << (generic_last ? ", generic op last" : ", fused op last");
+    }
+  }
+  ad::set_num_threads(2);
+}
+
 TEST(FusedMlpStep, SameThreadCountGivesBitIdenticalGradients) {
   EXPECT_EQ(hnn_step_gradients<double>(true, 2), hnn_step_gradients<double>(true, 2));
 }
