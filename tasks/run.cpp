@@ -159,6 +159,7 @@ json run_metrics(const TaskRun& run, const RunFolder& folder, const TrainResult&
                  const RunSettings& settings) {
   json metrics = timed_evaluation(run, &folder);
   metrics["train_seconds"] = trained.seconds;
+  metrics["curve_seconds"] = trained.curve_seconds;
   if (!trained.fit.is_null()) metrics["fit"] = trained.fit;
   metrics["final_batch_loss"] =
       number(trained.curve.empty() ? NAN : trained.curve.back().train_loss);

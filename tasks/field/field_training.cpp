@@ -74,6 +74,7 @@ TrainResult FieldTraining::train(nn::DynamicsModel<T>& model, const Dataset& dat
   adam.run_settings["fit"] = sampled.fit;  // its checkpoints carry the report
   TrainResult trained = train_steps(model, data, s, adam);
   trained.seconds += sampled.seconds;
+  trained.curve_seconds += sampled.curve_seconds;
   trained.fit = std::move(sampled.fit);
   return trained;
 }

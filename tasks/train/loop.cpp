@@ -77,11 +77,14 @@ class TrainClock {
   double seconds() const {
     return earlier_ + (std::chrono::duration<double>(Clock::now() - start_) - paused_).count();
   }
+  /// Runs work off the clock; returns its seconds.
   template <typename F>
-  void pause_for(F&& work) {
+  double pause_for(F&& work) {
     const auto start = Clock::now();
     work();
-    paused_ += Clock::now() - start;
+    const auto took = Clock::now() - start;
+    paused_ += took;
+    return std::chrono::duration<double>(took).count();
   }
 
  private:
@@ -183,7 +186,7 @@ class Loop {
 
   void record(long step, double loss) {
     if (step % interval_ != 0 && step != o_.steps) return;
-    clock_.pause_for([&] {
+    result_.curve_seconds += clock_.pause_for([&] {
       result_.curve.push_back(
           unless_the_field_fails(step, "the loss curve's splits", checkpoints_.last_good(),
                                  [&] { return objective_.curve_point(step, loss); }));

@@ -20,6 +20,9 @@ namespace hnn::tasks {
 struct TrainResult {
   std::vector<CurvePoint> curve{};
   double seconds = 0;  // the fit and training steps only (no data, loss-curve points, evaluation)
+  /// This process's loss-curve points: each evaluates the train and test loss on up to
+  /// thousands of rows, 100 times a run, so in a short run they can take longer than the steps.
+  double curve_seconds = 0;
   long steps = 0;
   /// metrics.json's "fit" where the hidden layers were sampled (tasks/train/fit_method.h);
   /// null for Adam alone.

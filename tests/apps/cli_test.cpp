@@ -219,7 +219,8 @@ TEST(CliTrain, PrintsASummaryNotTheJson) {
         fmt::format("MSE {:.3g} ± {:.2g} against the true H", m["energy_mse"].get<double>(),
                     m["energy_mse_se"].get<double>()),
         fmt::format("relative {:.3g}", m["energy_relative_mse"].get<double>()),
-        std::string("training "), std::string("metrics.json, params.bin, rollout.csv")}) {
+        std::string("training "), std::string(", loss curve "),
+        std::string("metrics.json, params.bin, rollout.csv")}) {
     EXPECT_NE(r.out.find(want), std::string::npos) << want << " is not in:\n" << r.out;
   }
   // evaluate says what it did: which parameters, on which data, what it wrote.

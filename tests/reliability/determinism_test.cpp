@@ -40,7 +40,7 @@ void expect_same_seed_same_files(const std::vector<std::string>& extra) {
   const nlohmann::json c = read_json(dir / "c" / "metrics.json");
   EXPECT_EQ(without_timings(a), without_timings(b));
   // Only the timings are left out, and every other key is there.
-  EXPECT_EQ(a.size(), without_timings(a).size() + 3);
+  EXPECT_EQ(a.size(), without_timings(a).size() + 4);
   for (const char* key : {"train_loss", "test_loss", "energy_mse", "final_batch_loss"}) {
     EXPECT_NE(a[key], c[key]) << key;
   }

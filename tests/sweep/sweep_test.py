@@ -25,7 +25,7 @@ import unittest
 
 HNN = os.environ.get("HNN_EXE", "build/apps/hnn")
 SOURCE = os.environ.get("HNN_SOURCE_DIR", os.getcwd())
-TIMINGS = ("train_seconds", "eval_seconds", "data_seconds")  # reliability_util.h without_timings
+TIMINGS = ("train_seconds", "curve_seconds", "eval_seconds", "data_seconds")  # reliability_util.h without_timings
 
 
 def hnn(*args, **kwargs):

@@ -63,6 +63,7 @@ void expect_complete_metrics(const json& m, const std::string& task, const std::
     EXPECT_LT(m[std::string(key) + "_se"].get<double>(), m[key].get<double>()) << key;
   }
   EXPECT_GE(m["train_seconds"].get<double>(), 0);
+  EXPECT_GT(m["curve_seconds"].get<double>(), 0);  // the loss curve's points, off the train clock
 }
 
 // loss_curve.csv: "step,train_loss,test_loss", one row per recorded step, the last one `steps`.
@@ -195,7 +196,8 @@ TEST(EvaluateRun, RejectsAFolderThatIsNoRun) {
 
 // Everything but timings.
 json without_timings(json m) {
-  for (const char* key : {"train_seconds", "eval_seconds", "data_seconds"}) m.erase(key);
+  for (const char* key : {"train_seconds", "curve_seconds", "eval_seconds", "data_seconds"})
+    m.erase(key);
   return m;
 }
 

@@ -199,8 +199,10 @@ std::string masses_line(const json& m) {
 }
 
 std::string timing_line(const json& m) {
-  constexpr std::pair<const char*, const char*> kTimes[] = {
-      {"train_seconds", "training"}, {"data_seconds", "data"}, {"eval_seconds", "evaluation"}};
+  constexpr std::pair<const char*, const char*> kTimes[] = {{"train_seconds", "training"},
+                                                            {"curve_seconds", "loss curve"},
+                                                            {"data_seconds", "data"},
+                                                            {"eval_seconds", "evaluation"}};
   std::vector<std::string> parts;
   for (const auto& [key, name] : kTimes) {
     if (const auto s = number_at(m, key)) parts.push_back(fmt::format("{} {:.1f} s", name, *s));
