@@ -52,17 +52,24 @@ def mark_slower(rows):
 
 
 def best_against_best(rows, cases):
-    """Per case, each side at its own faster thread count, and PyTorch's best / hnn's best."""
+    """Per case, each side at its own faster thread count, and PyTorch's best / hnn's best; with
+    several rounds also the lowest and highest ratio of one round's two runs (`round_ratios`):
+    each round runs both sides minutes apart at most, so the spread shows how far the machine's
+    load moved the ratio, which the medians hide."""
     best = []
     for case in cases:
         mine = [r for r in rows if r["case"] == case]
         entry = {"case": case}
         for impl in IMPLS:
-            timed = [(r[impl]["ms"], r["threads"]) for r in mine if impl in r]
+            timed = [(r[impl]["ms"], r["threads"], r[impl]["runs"]) for r in mine if impl in r]
             if timed:
-                entry[impl] = dict(zip(("ms", "threads"), min(timed)))
+                ms, threads, runs = min(timed, key=lambda t: t[:2])
+                entry[impl] = {"ms": ms, "threads": threads, "runs": runs}
         if "hnn" in entry and "pytorch" in entry:
             entry["pytorch/hnn"] = entry["pytorch"]["ms"] / entry["hnn"]["ms"]
+            paired = [t / h for h, t in zip(entry["hnn"]["runs"], entry["pytorch"]["runs"])]
+            if len(paired) > 1:
+                entry["round_ratios"] = (min(paired), max(paired))
         best.append(entry)
     return best
 
@@ -138,13 +145,16 @@ def main_table(rows):
 
 
 def best_table(best):
-    lines = ["", "Each side at its own faster thread count:", "",
-             "| case | hnn ms/step (threads) | PyTorch ms/step (threads) | PyTorch/hnn |",
-             "| --- | --- | --- | --- |"]
+    lines = ["", "Each side at its own faster thread count (the ratio's range: its lowest and highest"
+             " in one round):", "",
+             "| case | hnn ms/step (threads) | PyTorch ms/step (threads) | PyTorch/hnn |"
+             " range over rounds |",
+             "| --- | --- | --- | --- | --- |"]
     for b in best:
         cell = lambda i: f"{b[i]['ms']:.3f} ({b[i]['threads']})" if i in b else "-"
         ratio = f"{b['pytorch/hnn']:.2f}x" if "pytorch/hnn" in b else "-"
-        lines.append(f"| {b['case']} | {cell('hnn')} | {cell('pytorch')} | {ratio} |")
+        spread = "{:.2f}-{:.2f}x".format(*b["round_ratios"]) if "round_ratios" in b else "-"
+        lines.append(f"| {b['case']} | {cell('hnn')} | {cell('pytorch')} | {ratio} | {spread} |")
     return lines
 
 

@@ -1,7 +1,7 @@
 """The tables of report.py on hand-made runs (ctest bench.CompareReport)."""
 import unittest
 
-from report import best_against_best, main_table, markdown, summarise
+from report import best_against_best, best_table, main_table, markdown, summarise
 
 
 def run(impl, threads, ms, flops=None):
@@ -48,7 +48,16 @@ class ReportTest(unittest.TestCase):
         text = markdown(meta, self.rows, self.best, [])
         self.assertIn("AMD EPYC (family 25, model 17", text)
         self.assertIn("3.000 (slower than 1 thread)", text)
-        self.assertIn("| c | 2.000 (1) | 5.000 (2) | 2.50x |", text)
+        self.assertIn("| c | 2.000 (1) | 5.000 (2) | 2.50x | - |", text)
+
+    def test_the_best_ratio_s_range_pairs_the_two_sides_round_by_round(self):
+        # Round 1: hnn 2.0, PyTorch 5.0 (2.5x); round 2: 4.0 and 6.0 (1.5x); medians 3.0, 5.5.
+        runs = [run("hnn", 1, 2.0), run("pytorch", 1, 5.0), run("hnn", 1, 4.0),
+                run("pytorch", 1, 6.0)]
+        best = best_against_best(summarise(runs, ["c"], [1]), ["c"])[0]
+        self.assertAlmostEqual(best["pytorch/hnn"], 5.5 / 3.0)
+        self.assertEqual(best["round_ratios"], (1.5, 2.5))
+        self.assertIn("| 1.83x | 1.50-2.50x |", "\n".join(best_table([best])))
 
     def test_a_peak_that_moved_between_its_reads_is_reported(self):
         meta = {"date": "d", "cpu": "AMD EPYC", "cpus": 2, "commit": "abc", "load_start": 0.1,
