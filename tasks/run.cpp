@@ -312,13 +312,23 @@ RolloutWritten write_rollout(const fs::path& run_dir, const RolloutCommand& comm
   if (!command.states.empty()) request.initial_states = states_from_values(command.states, names);
   if (!command.states_file.empty())
     request.initial_states = states_from_file(command.states_file, names);
+  std::vector<std::string> notes;
+  if (request.initial_states.rows() > 0) {
+    request.initial_states =
+        loaded.run->given_states(std::move(request.initial_states), command.project, notes);
+  } else {
+    HNN_TASKS_CHECK(!command.project,
+                    "--project moves given states (--state, --states) onto the constraints; the "
+                    "run's own test states are on them");
+  }
   RolloutOutput output = loaded.run->rollout(request);
+  notes.insert(notes.end(), output.notes.begin(), output.notes.end());
   const fs::path path = command.out.empty()
                             ? run_dir / fmt::format("rollout_{}.csv", request.integrator)
                             : command.out;
   RunFolder(path.parent_path().empty() ? "." : path.parent_path())
       .write_text(path.filename().string(), output.csv);
-  return {.path = path, .trajectories = output.trajectories, .notes = std::move(output.notes)};
+  return {.path = path, .trajectories = output.trajectories, .notes = std::move(notes)};
 }
 
 json reversibility(const fs::path& run_dir, const ReversibilityOptions& options,

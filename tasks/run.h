@@ -70,6 +70,7 @@ struct RolloutCommand {
   RolloutRequest request{};
   std::vector<std::string> states{};
   std::string states_file{};
+  bool project = false;  ///< move the given states onto a constrained system's constraints
   std::string data_file{};
   std::filesystem::path out{};
 };

@@ -50,6 +50,14 @@ std::vector<std::string> TaskRun::state_names() const {
   return names;
 }
 
+physics::Batch TaskRun::given_states(physics::Batch x, bool project,
+                                     std::vector<std::string>&) const {
+  HNN_TASKS_CHECK(!project,
+                  "--project moves given states onto a constrained system's constraints (the "
+                  "constrained tasks in Cartesian coordinates); this run's states have none");
+  return x;
+}
+
 int trajectories_to_write(const RolloutRequest& request, int available, std::string_view what) {
   if (!request.trajectories) return std::min(RolloutRequest::kDefaultTrajectories, available);
   HNN_TASKS_CHECK(*request.trajectories <= available,

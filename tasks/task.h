@@ -75,6 +75,13 @@ class TaskRun {
   /// The names of the state's columns, in order: what `hnn rollout --states FILE` names and
   /// rollout CSVs use. By default x_0..x_{d-1}.
   virtual std::vector<std::string> state_names() const;
+  /// States given to `hnn rollout` (rows, in state_names()' order), as the truth starts from
+  /// them. A constrained system's run refuses one off its constraints, naming it and the
+  /// constraint, or with `project` moves them onto the constraints and says how far in `notes`.
+  /// By default they are used as given, and `project` is refused: there is nothing to move
+  /// them onto.
+  virtual physics::Batch given_states(physics::Batch x, bool project,
+                                      std::vector<std::string>& notes) const;
 
   /// The learned field (in double) and the states its rollouts start from: the phase space, or
   /// the latent space of a task that learns one. For reversibility and the like.

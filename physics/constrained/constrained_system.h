@@ -102,6 +102,11 @@ class ConstrainedSystem : public System {
   /// J(x) v for every row (d phi/dt), rows x C.
   Batch constraint_velocities(const Batch& z) const;
 
+  /// Why state z (2 N d values: positions, then velocities) is off the manifold, in words that
+  /// name the constraint ("points 0 and 1 are 0.9 apart, their rod is 1.08 long"); empty when
+  /// every constraint holds to tol, relative to the rod's length (or the pivot's distance from
+  /// the origin) for positions and to the points' relative speed for velocities.
+  std::string state_problem(const double* z, double tol = 1e-6) const;
   /// Back onto the manifold: positions by Gauss-Newton steps of least M-norm
   /// (dx = -M^-1 J^T (J M^-1 J^T)^-1 phi) until |phi| < 1e-13 (1 + scale), then velocities
   /// M-orthogonally onto J v = 0. Throws std::runtime_error when 50 steps do not converge.

@@ -228,6 +228,23 @@ class ConstrainedTask : public FieldTask {
                                                                      : "angles (theta, omega)";
   }
 
+  // A given Cartesian state must keep the rods' lengths, the pins, and their rates at 0: off
+  // them, the projected truth would move a system with other rods. Angle coordinates keep them
+  // by construction.
+  std::string state_problem(const Batch& x, Eigen::Index row) const override {
+    if (coordinates_ != Coordinates::kCartesian) return "";
+    return cartesian_.state_problem(&x(row, 0));
+  }
+
+  std::pair<Batch, double> project_states(const Batch& x) const override {
+    HNN_TASKS_CHECK(coordinates_ == Coordinates::kCartesian,
+                    "--project moves Cartesian states onto {}'s constraints; this run's states "
+                    "are angles, which keep them by construction",
+                    name());
+    Batch moved = cartesian_.project(x);
+    return {moved, (moved - x).rowwise().norm().maxCoeff()};
+  }
+
   // Cartesian (x, v) rows of states in this task's coordinates.
   Batch to_cartesian(const Batch& x) const {
     if (coordinates_ == Coordinates::kAngles) return angles_->to_cartesian(x);

@@ -79,6 +79,27 @@ class FieldRun : public FieldModelRun {
     return m;
   }
 
+  // Given states the truth cannot start from are refused one line each, naming the state (1 for
+  // the first) and why; with --project they are moved onto the constraints first.
+  Batch given_states(Batch x, bool project, std::vector<std::string>& notes) const override {
+    if (project) {
+      auto [moved, largest] = task_.project_states(x);
+      notes.push_back(
+          fmt::format("moved {} given state{} onto {}'s constraints, the furthest by "
+                      "{:.3g}",
+                      x.rows(), x.rows() == 1 ? "" : "s", task_.name(), largest));
+      return std::move(moved);
+    }
+    for (Eigen::Index row = 0; row < x.rows(); ++row) {
+      const std::string problem = task_.state_problem(x, row);
+      HNN_TASKS_CHECK(problem.empty(),
+                      "given state {} is off {}'s constraints: {}; --project moves given states "
+                      "onto them",
+                      row + 1, task_.name(), problem);
+    }
+    return x;
+  }
+
   // With a true system, it and the model from each initial state over the whole span; without
   // one, the measured paths from the test states, or the model alone from given states.
   RolloutOutput rollout(const RolloutRequest& r) const override {
@@ -208,6 +229,15 @@ class FieldRun : public FieldModelRun {
 }  // namespace
 
 void FieldTask::add_metrics(const Rollouts&, nlohmann::json&) const {}
+
+std::string FieldTask::state_problem(const Batch&, Eigen::Index) const { return ""; }
+
+std::pair<Batch, double> FieldTask::project_states(const Batch&) const {
+  throw Error(
+      fmt::format("--project moves given states onto a constrained system's "
+                  "constraints; {}'s states have none",
+                  name()));
+}
 
 std::vector<Stretch> regular_stretches(const Batch& x, int points, double t_end) {
   const std::vector<double> t = physics::linspace(0.0, t_end, points);

@@ -73,6 +73,12 @@ class FieldTask : public Task {
   /// The constrained system a CHNN or CLNN is built on (points, masses, constraints); empty
   /// where the task has none, and those models are not among its models().
   virtual nn::ConstraintSpec constraints() const { return {}; }
+  /// Why row `row` of states given to `hnn rollout` cannot start the truth (a constrained
+  /// system's state off its constraints), in words; empty when it can. By default every state can.
+  virtual std::string state_problem(const Batch& x, Eigen::Index row) const;
+  /// Given states moved onto the truth's constraints (`hnn rollout --project`), and the largest
+  /// move. By default an Error: the task's states have no constraints.
+  virtual std::pair<Batch, double> project_states(const Batch& x) const;
   /// The models' input scales (nn::DynamicsConfig::input_scale); by default none.
   virtual std::vector<double> input_scale() const { return {}; }
 

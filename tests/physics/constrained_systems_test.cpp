@@ -113,6 +113,46 @@ TEST(ConstrainedProjection, LandsOnTheManifoldAndIsIdempotent) {
   }
 }
 
+// Every system: its sampled states have no problem; moved by 1e-3, each has one that names a
+// constraint in words, and projected back it has none again.
+TEST(ConstrainedProjection, StateProblemNamesTheConstraintAStateIsOff) {
+  for (const std::string& name : constrained_system_names()) {
+    SCOPED_TRACE(name);
+    const ConstrainedSystem system = make_constrained_system(name);
+    std::mt19937_64 rng(4);
+    const Batch z0 = system.sample_initial_states(3, rng);
+    std::normal_distribution<double> normal;
+    Batch moved = z0;
+    for (Eigen::Index i = 0; i < moved.size(); ++i) moved.data()[i] += 1e-3 * normal(rng);
+    const Batch back = system.project(moved);
+    for (Eigen::Index r = 0; r < z0.rows(); ++r) {
+      EXPECT_EQ(system.state_problem(&z0(r, 0)), "");
+      const std::string problem = system.state_problem(&moved(r, 0));
+      EXPECT_TRUE(problem.find(" apart, their rod is ") != std::string::npos ||
+                  problem.find("from its pivot") != std::string::npos)
+          << problem;
+      EXPECT_EQ(system.state_problem(&back(r, 0)), "");
+    }
+  }
+}
+
+// The two-link chain's words: which rod, how long it is, how long it must be; and a state whose
+// positions keep the rods but whose velocities stretch one.
+TEST(ConstrainedProjection, StateProblemOfTheChainSaysWhichRodAndHowFar) {
+  const ConstrainedSystem chain = chain_pendulum(Eigen::Vector2d(1, 1), Eigen::Vector2d(1, 2));
+  Eigen::VectorXd z(8);
+  z << 0, -1, 0, -2.5, 0, 0, 0, 0;  // the rod from point 0 to 1 is 1.5, not 2
+  EXPECT_EQ(chain.state_problem(z.data()), "points 0 and 1 are 1.5 apart, their rod is 2 long");
+  z << 0, -0.5, 0, -2.5, 0, 0, 0, 0;
+  EXPECT_EQ(chain.state_problem(z.data()),
+            "point 0 and its anchor are 0.5 apart, their rod is 1 long");
+  z << 0, -1, 0, -3, 0, 0, 0, 0.5;  // point 1 falls along its rod
+  EXPECT_EQ(chain.state_problem(z.data()),
+            "points 0 and 1 move apart at -0.5 a time unit, along a rod of fixed length");
+  z << 0, -1, 0, -3, 1, 0, 2, 0;  // swinging: velocities across the rods
+  EXPECT_EQ(chain.state_problem(z.data()), "");
+}
+
 TEST(ConstrainedTruth, ProjectedFormKeepsAViolationConstantWhereTheMultipliersWouldGrowIt) {
   // Velocities off the tangent space by ~1e-2: with the multiplier form phi would grow like
   // (J v) t; the projected form (Note [Projected form]) keeps phi and J v where they started.

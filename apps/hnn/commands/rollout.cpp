@@ -59,6 +59,10 @@ void add_rollout_command(CLI::App& app) {
                   "data run's own names, or x_0..x_{d-1})")
       ->excludes(trajectories)
       ->excludes(state);
+  cmd->add_flag("--project", o->command.project,
+                "Move the given states onto the system's constraints first (the constrained "
+                "tasks: rods keep their lengths, velocities move along them); without it, a state "
+                "off them is refused");
   cmd->add_option("--data", o->command.data_file, "The run's data file, when it has moved")
       ->check(CLI::ExistingFile);
   cmd->add_option("--out", o->command.out, "CSV file (default RUN/rollout_INTEGRATOR.csv)");
