@@ -93,15 +93,24 @@ TEST(ConstrainedField, MultipliersKeepTheSecondDerivativeOfTheConstraintsZero) {
   }
 }
 
+// Three states from the system's sampler, and the same moved off the manifold by 1e-3 N(0, 1).
+Batch sampled(const ConstrainedSystem& system, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  return system.sample_initial_states(3, rng);
+}
+Batch moved_off(const Batch& z0, std::uint64_t seed) {
+  std::mt19937_64 rng(seed + 1000);
+  std::normal_distribution<double> normal;
+  Batch moved = z0;
+  for (Eigen::Index i = 0; i < moved.size(); ++i) moved.data()[i] += 1e-3 * normal(rng);
+  return moved;
+}
+
 TEST(ConstrainedProjection, LandsOnTheManifoldAndIsIdempotent) {
   for (const std::string& name : constrained_system_names()) {
     SCOPED_TRACE(name);
     const ConstrainedSystem system = make_constrained_system(name);
-    std::mt19937_64 rng(3);
-    const Batch z0 = system.sample_initial_states(3, rng);
-    std::normal_distribution<double> normal;
-    Batch moved = z0;
-    for (Eigen::Index i = 0; i < moved.size(); ++i) moved.data()[i] += 1e-3 * normal(rng);
+    const Batch moved = moved_off(sampled(system, 3), 3);
     const Batch once = system.project(moved);
     EXPECT_LT(max_abs(system.constraint_values(once)), 1e-11);
     EXPECT_LT(max_abs(system.constraint_velocities(once)), 1e-12 * (1.0 + max_abs(once)));
@@ -119,11 +128,8 @@ TEST(ConstrainedProjection, StateProblemNamesTheConstraintAStateIsOff) {
   for (const std::string& name : constrained_system_names()) {
     SCOPED_TRACE(name);
     const ConstrainedSystem system = make_constrained_system(name);
-    std::mt19937_64 rng(4);
-    const Batch z0 = system.sample_initial_states(3, rng);
-    std::normal_distribution<double> normal;
-    Batch moved = z0;
-    for (Eigen::Index i = 0; i < moved.size(); ++i) moved.data()[i] += 1e-3 * normal(rng);
+    const Batch z0 = sampled(system, 4);
+    const Batch moved = moved_off(z0, 4);
     const Batch back = system.project(moved);
     for (Eigen::Index r = 0; r < z0.rows(); ++r) {
       EXPECT_EQ(system.state_problem(&z0(r, 0)), "");
