@@ -218,5 +218,16 @@ class PlotTest(unittest.TestCase):
         self.assertNotIn("Traceback", run.stderr)
 
 
+class Table1HeadroomTest(unittest.TestCase):
+    def test_bars_spanning_many_decades_leave_room_for_the_tallest_label(self):
+        import numpy as np
+
+        from charts.table1 import headroom
+        self.assertEqual(headroom(np.array([1e-3, 1e-1])), 1e3)  # at least 3 decades
+        # The three-body baseline's 3.7e+07 over the two-body HNN's 2e-06 (the axis starts at a
+        # fifth of it): 14 decades, 4.2 of them above the tallest bar.
+        self.assertAlmostEqual(np.log10(headroom(np.array([2e-6, 3.7e7]))), 4.19, places=2)
+
+
 if __name__ == "__main__":
     unittest.main()
