@@ -126,7 +126,8 @@ class DynamicsModel : public Module<T> {
   /// time_derivative's values on a constant x under a NoGradGuard.
   virtual Matrix<T> field(const MatrixView<T>& x) const;
   /// Whether the model learns a quantity its motion conserves (an HNN's H, an LNN's energy
-  /// v . dL/dv - L, a mass HNN's H), and that quantity of states x, R x 1. The default learns
+  /// v . dL/dv - L, a mass HNN's H, a CHNN's or CLNN's 1/2 v^T M v + V), and that quantity of
+  /// states x, R x 1. The default learns
   /// none, and learned_energy then throws std::logic_error.
   virtual bool has_learned_energy() const { return false; }
   virtual Matrix<T> learned_energy(const MatrixView<T>& x) const;

@@ -35,8 +35,8 @@ Eigen::VectorXd TaskRun::learned_h(const physics::Batch& x) const {
   const std::unique_ptr<nn::DynamicsModel<double>> model = model_in_data_units();
   const LearnedField learned = learned_field(*model);
   HNN_TASKS_CHECK(learned.hamiltonian,
-                  "a {} model learns no scalar H (it predicts dx/dt directly): only an hnn, dhnn "
-                  "or lnn run has one",
+                  "a {} model learns no scalar H (it predicts dx/dt directly): the hnn, dhnn, "
+                  "lnn, hnn-mass, chnn and clnn models learn one",
                   nn::to_string(model->config().model));
   return learned.hamiltonian(x);
 }

@@ -195,7 +195,6 @@ std::string rollout_paths_csv(const physics::System& truth, const nn::DynamicsMo
   const physics::VectorField learned = [&model](double, const Batch& x, Batch& dxdt) {
     dxdt = model.field(x);
   };
-  const auto* hnn = dynamic_cast<const nn::Hnn<double>*>(&model);
   const physics::Trajectory true_paths = integrator.integrate(truth.field(), x0, t);
   const physics::Trajectory model_paths = integrator.integrate(learned, x0, t);
   RolloutCsv csv(numbered_columns("x", x0.cols()));
@@ -203,7 +202,8 @@ std::string rollout_paths_csv(const physics::System& truth, const nn::DynamicsMo
     const Batch true_states = true_paths.path(row), states = model_paths.path(row);
     csv.add(kTrueSource, std::size_t(row), t, true_states, truth.energy_batch(true_states));
     csv.add(model_name, std::size_t(row), t, states, truth.energy_batch(states),
-            hnn ? Eigen::VectorXd(hnn->energy(states).col(0)) : Eigen::VectorXd());
+            model.has_learned_energy() ? Eigen::VectorXd(model.learned_energy(states).col(0))
+                                       : Eigen::VectorXd());
   }
   return csv.str();
 }

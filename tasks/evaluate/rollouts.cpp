@@ -118,7 +118,8 @@ void add_learned(Rollouts& r, const LearnedField& learned, const Batch& starts, 
 LearnedField learned_field(const nn::DynamicsModel<double>& model) {
   LearnedField learned{
       .field = [&model](double, const Batch& x, Batch& dxdt) { dxdt = model.field(x); }};
-  // What the learned motion conserves: an HNN's H, an LNN's energy, a mass HNN's H.
+  // What the learned motion conserves: an HNN's H, an LNN's energy, a mass HNN's H, a CHNN's or
+  // CLNN's kinetic plus learned potential energy.
   if (model.has_learned_energy())
     learned.hamiltonian = [&model](const Batch& x) -> Eigen::VectorXd {
       return model.learned_energy(x).col(0);

@@ -7,6 +7,10 @@
 #include <fmt/ranges.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+#include <map>
+
 #include "reliability_util.h"
 
 namespace hnn::reliability {
@@ -145,6 +149,46 @@ TEST(HamiltonianGridOfATask, ATaskSystemGivesTheTrueEnergyUnderNumberedColumns) 
             std::vector<std::string>({"2", "1"}));
   EXPECT_EQ(first_row_of(rollout, "true").at(5), last[3]);
   EXPECT_EQ(first_row_of(rollout, "hnn").at(6), last[2]);
+}
+
+// A CHNN learns V with the known masses: its energy 1/2 v^T M v + V is what its motion conserves.
+// `hnn rollout` writes it in the learned_h column, constant along the learned path, and `hnn
+// hamiltonian` draws it on a slice.
+TEST(HamiltonianGridOfATask, AChnnRunGivesItsLearnedEnergyConservedAlongItsRollouts) {
+  const TempDir dir;
+  ASSERT_EQ(run_hnn({"train", "chain-pendulum-2", "--model", "chnn", "--steps", "2", "--batch", "4",
+                     "--hidden", "8", "--settings",
+                     R"({"trajectories": 6, "validation": 2, "rollouts": 2})", "--quiet", "--out",
+                     (dir / "run").string()},
+                    dir.path())
+                .code,
+            0);
+  const fs::path rollout = dir / "rollout.csv";
+  ASSERT_EQ(run_hnn({"rollout", (dir / "run").string(), "--trajectories", "2", "--points", "30",
+                     "--out", rollout.string()},
+                    dir.path())
+                .code,
+            0);
+  std::map<std::string, std::pair<double, double>> range;  // per trajectory: min, max
+  for (const std::string& line : lines(read_text(rollout))) {
+    if (!line.starts_with("chnn,")) continue;
+    const std::vector<std::string> cells = cells_of(line);
+    ASSERT_EQ(cells.size(), 13u) << line;  // source, traj, t, 8 state columns, energy, learned_h
+    ASSERT_FALSE(cells[12].empty()) << line;
+    const double h = std::stod(cells[12]);
+    auto [it, fresh] = range.try_emplace(cells[1], h, h);
+    it->second = {std::min(it->second.first, h), std::max(it->second.second, h)};
+  }
+  ASSERT_EQ(range.size(), 2u);
+  for (const auto& [traj, r] : range) {
+    EXPECT_LT(r.second - r.first, 1e-6 * std::max(1.0, std::abs(r.first))) << "trajectory " << traj;
+  }
+  const Result grid = run_hnn(
+      {"hamiltonian", (dir / "run").string(), "--grid", "x_0=-1:1,x_1=-2:0", "--at",
+       "x_2=0,x_3=-2,x_4=0,x_5=0,x_6=0,x_7=0", "--points", "2", "--out", (dir / "g.csv").string()},
+      dir.path());
+  ASSERT_EQ(grid.code, 0) << grid.err;
+  EXPECT_EQ(lines(read_text(dir / "g.csv")).size(), 5u);
 }
 
 }  // namespace
