@@ -80,7 +80,7 @@ ad::Var<T> ConstrainedModel<T>::potential(const ad::Var<T>& x) const {
 }
 
 template <typename T>
-Matrix<T> ConstrainedModel<T>::energy(const Matrix<T>& x) const {
+Matrix<T> ConstrainedModel<T>::energy(const MatrixView<T>& x) const {
   this->check_input("energy", x.rows(), x.cols());
   ad::TapeScope scope;
   ad::NoGradGuard values_only;

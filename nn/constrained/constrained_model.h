@@ -31,10 +31,10 @@ class ConstrainedModel : public DynamicsModel<T> {
   /// The learned potential V(positions) of states x (R x dim), R x 1, on the tape.
   ad::Var<T> potential(const ad::Var<T>& x) const;
   /// The learned energy 1/2 v^T M v + V, R x 1: what the learned motion conserves.
-  Matrix<T> energy(const Matrix<T>& x) const;
+  Matrix<T> energy(const MatrixView<T>& x) const;
   /// The same energy, as rollouts (their learned_h column) and `hnn hamiltonian` ask for it.
   bool has_learned_energy() const override { return true; }
-  Matrix<T> learned_energy(const MatrixView<T>& x) const override { return energy(Matrix<T>(x)); }
+  Matrix<T> learned_energy(const MatrixView<T>& x) const override { return energy(x); }
 
   /// (dpositions/dt, dvelocities/dt), R x dim, on the tape to any order (training differentiates
   /// through dV/dx, the Gram blocks and the solves). Throws ad::Error naming the row where the

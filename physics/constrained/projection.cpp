@@ -23,50 +23,37 @@ bool off(double value, double scale, double tol) {
 
 std::string ConstrainedSystem::state_problem(const double* z, double tol) const {
   const int d = spec_.dim;
-  const double* x = z;
-  const double* v = z + configuration_dim();
-  // A rod from point i to point j (or to an anchor): its length, then how fast it stretches.
-  const auto rod = [&](int i, int j, const double* anchor, double length) -> std::string {
-    double rr = 0, ru = 0, uu = 0;
-    for (int k = 0; k < d; ++k) {
-      const double r = x[i * d + k] - (j >= 0 ? x[j * d + k] : anchor[k]);
-      const double u = v[i * d + k] - (j >= 0 ? v[j * d + k] : 0.0);
-      rr += r * r;
-      ru += r * u;
-      uu += u * u;
-    }
-    const std::string ends = j >= 0
-                                 ? fmt::format("points {} and {}", std::min(i, j), std::max(i, j))
-                                 : fmt::format("point {} and its anchor", i);
-    const double distance = std::sqrt(rr);
-    if (off(distance - length, length, tol)) {
+  // linearize's rows: one per rod (phi = |r|^2 - l^2, J v = 2 r . u), then d per pin (its
+  // offset from the pivot and its velocity, an axis each).
+  const Linearization lin = linearize(z, z + configuration_dim());
+  const double speeds =
+      Eigen::Map<const Eigen::VectorXd>(z + configuration_dim(), configuration_dim()).norm();
+  int row = 0;
+  const auto rod = [&](const std::string& ends, double length) -> std::string {
+    const double distance = std::sqrt(std::max(0.0, lin.phi[row] + length * length));
+    const double stretch = distance > 0 ? lin.jv[row] / (2 * distance) : 0.0;
+    ++row;
+    if (off(distance - length, length, tol))
       return fmt::format("{} are {:.6g} apart, their rod is {:.6g} long", ends, distance, length);
-    }
-    const double stretch = distance > 0 ? ru / distance : 0.0;
-    if (off(stretch, std::sqrt(uu), tol)) {
+    if (off(stretch, speeds, tol))
       return fmt::format("{} move apart at {:.3g} a time unit, along a rod of fixed length", ends,
                          stretch);
-    }
     return "";
   };
   for (const auto& c : spec_.distances) {
-    if (std::string p = rod(c.i, c.j, nullptr, c.length); !p.empty()) return p;
+    const auto ends = fmt::format("points {} and {}", std::min(c.i, c.j), std::max(c.i, c.j));
+    if (std::string p = rod(ends, c.length); !p.empty()) return p;
   }
   for (const auto& c : spec_.anchors) {
-    if (std::string p = rod(c.i, -1, c.anchor.data(), c.length); !p.empty()) return p;
+    if (std::string p = rod(fmt::format("point {} and its anchor", c.i), c.length); !p.empty())
+      return p;
   }
-  for (std::size_t n = 0; n < spec_.pins.size(); ++n) {
-    const PinConstraint& pin = spec_.pins[n];
-    Eigen::VectorXd position = -pin.point, velocity = Eigen::VectorXd::Zero(d);
-    for (int j = 0; j < spec_.points; ++j) {
-      position += pin.weights[j] * Eigen::Map<const Eigen::VectorXd>(x + j * d, d);
-      velocity += pin.weights[j] * Eigen::Map<const Eigen::VectorXd>(v + j * d, d);
-    }
-    if (off(position.norm(), pin.point.norm(), tol))
-      return fmt::format("pinned point {} is {:.3g} from its pivot", n, position.norm());
-    const double speeds = Eigen::Map<const Eigen::VectorXd>(v, configuration_dim()).norm();
-    if (off(velocity.norm(), speeds, tol))
-      return fmt::format("pinned point {} moves at {:.3g}, held at its pivot", n, velocity.norm());
+  for (std::size_t n = 0; n < spec_.pins.size(); ++n, row += d) {
+    const double offset = lin.phi.segment(row, d).norm(), speed = lin.jv.segment(row, d).norm();
+    if (off(offset, spec_.pins[n].point.norm(), tol))
+      return fmt::format("pinned point {} is {:.3g} from its pivot", n, offset);
+    if (off(speed, speeds, tol))
+      return fmt::format("pinned point {} moves at {:.3g}, held at its pivot", n, speed);
   }
   return "";
 }
