@@ -16,6 +16,7 @@ import datetime
 import json
 import os
 import platform
+import re
 import subprocess
 import sys
 import time
@@ -83,7 +84,11 @@ def log(*args):
 
 def tuned_env(args, threads):
     env = dict(os.environ)
-    env.update(OPENBLAS_CORETYPE=args.coretype, OMP_NUM_THREADS=str(threads),
+    # auto: OpenBLAS picks the kernels for this CPU itself (undoing a machine's exported choice).
+    env.pop("OPENBLAS_CORETYPE", None)
+    if args.coretype != "auto":
+        env["OPENBLAS_CORETYPE"] = args.coretype
+    env.update(OMP_NUM_THREADS=str(threads),
                OPENBLAS_NUM_THREADS=str(threads), MKL_NUM_THREADS=str(threads),
                GLIBC_TUNABLES=MALLOC_TUNABLES)
     if Path(OPENBLAS_OPENMP).is_dir():
@@ -292,8 +297,37 @@ def machine(args):
             "cpu": cpuinfo("model name") or platform.processor() or "unknown CPU",
             "cpu_family": cpuinfo("cpu family"), "cpu_model": cpuinfo("model"),
             "cpus": os.cpu_count(), "commit": commit + ("+local changes" if dirty else ""),
-            "load_start": os.getloadavg()[0], "rounds": args.rounds,
-            "env": f"OPENBLAS_CORETYPE={args.coretype}, openblas-openmp, malloc tunables"}
+            "load_start": os.getloadavg()[0], "rounds": args.rounds}
+
+
+AVX512_CORES = {"SkylakeX", "Cooperlake", "SapphireRapids"}
+
+
+def blas_core(args, hnn):
+    """The kernels OpenBLAS runs in the runs' environment: the name of its OPENBLAS_VERBOSE=2
+    line 'Core: NAME', None for a BLAS that prints none. Exits when OpenBLAS ignores --coretype:
+    Debian's 0.3.21 answers OPENBLAS_CORETYPE=Cooperlake with 'Core not found' and runs Haswell's
+    AVX2 kernels on every CPU (OpenBLAS pull request 3806 fixed that later), so a run forced to
+    Cooperlake would have been recorded as AVX-512 while both sides ran AVX2."""
+    env = dict(tuned_env(args, 1), OPENBLAS_VERBOSE="2")
+    run = subprocess.run([str(hnn), "--fma-peak", "float32", "--threads", "1"], env=env,
+                         capture_output=True, text=True)
+    text = run.stdout + run.stderr
+    core = re.search(r"^Core: (\S+)", text, re.M)
+    if "Core not found" in text:
+        sys.exit(f"compare.py: --coretype {args.coretype}: this OpenBLAS has no such core (it ran"
+                 f" {core.group(1) if core else 'another'} instead); leave --coretype at auto, or"
+                 " name one it has")
+    core = core.group(1) if core else None
+    if core in AVX512_CORES and "avx512f" not in (cpuinfo("flags") or "").split():
+        sys.exit(f"compare.py: --coretype {args.coretype}: OpenBLAS's {core} kernels need AVX-512,"
+                 " which this CPU has not; leave --coretype at auto")
+    return core
+
+
+def env_line(args, core):
+    picked = "its own pick" if args.coretype == "auto" else f"OPENBLAS_CORETYPE={args.coretype}"
+    return f"OpenBLAS core {core or 'not reported'} ({picked}), openblas-openmp, malloc tunables"
 
 
 def fma_peaks(args, hnn):
@@ -326,7 +360,8 @@ def main():
     ap.add_argument("--steps-scale", type=float, default=1.0, help="scales the timing steps")
     ap.add_argument("--spring-data",
                     default=str(Path(__file__).resolve().parent / "data" / "spring_seed0.f64"))
-    ap.add_argument("--coretype", default="Cooperlake", help="OPENBLAS_CORETYPE for the runs")
+    ap.add_argument("--coretype", default="auto",
+                    help="OPENBLAS_CORETYPE for the runs; auto: the one OpenBLAS picks itself")
     ap.add_argument("--python", default="/usr/bin/python3", help="interpreter with torch")
     ap.add_argument("--timeout", type=float, default=900, help="seconds per timing run")
     ap.add_argument("--no-build", action="store_true")
@@ -343,6 +378,8 @@ def main():
 
     meta = machine(args)
     hnn, libtorch = build(args)
+    meta["blas_core"] = blas_core(args, hnn)
+    meta["env"] = env_line(args, meta["blas_core"])
     # Which BLAS each C++ program resolves in the runs' environment (Note: LD_LIBRARY_PATH picks
     # the OpenMP OpenBLAS over a linked pthreads one unless an RPATH says otherwise).
     for name, prog in (("hnn_blas", hnn), ("libtorch_blas", libtorch)):
