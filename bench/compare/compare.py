@@ -72,6 +72,17 @@ QUICK = ["spring-hnn-f32", "spring-hnn-f64", "twobody-hnn-f32", "threebody-hnn-f
 GROUPS = {"all": list(CASES), "quick": QUICK, "peers": [c for c in PEERS if c.endswith("f32")]}
 
 
+def expand_cases(names):
+    """The cases of a --cases value: case names and groups mixed ('peers,spring-hnn-f64'), each
+    case once, in order; exits naming an unknown one."""
+    cases = list(dict.fromkeys(c for name in names.split(",") for c in GROUPS.get(name, [name])))
+    for c in cases:
+        if c not in CASES:
+            sys.exit(f"unknown case {c}; known: {', '.join(CASES)}, and the groups "
+                     f"{', '.join(GROUPS)}")
+    return cases
+
+
 def case_options(case):
     """The options a case passes to every program besides task, model and dtype."""
     extra = CASES[case][4] if len(CASES[case]) > 4 else {}
@@ -355,7 +366,8 @@ def main():
     ap.add_argument("--rounds", type=int, default=3)
     ap.add_argument("--threads", default="2,1", help="thread counts, e.g. 2,1")
     ap.add_argument("--cases", default="all",
-                    help="comma-separated names, 'all', 'quick' or 'peers': " + ", ".join(CASES))
+                    help="comma-separated case names and groups ('all', 'quick', 'peers'): "
+                    + ", ".join(CASES))
     ap.add_argument("--impls", default=",".join(IMPLS))
     ap.add_argument("--steps-scale", type=float, default=1.0, help="scales the timing steps")
     ap.add_argument("--spring-data",
@@ -371,10 +383,7 @@ def main():
     args = ap.parse_args()
     args.threads = [int(t) for t in args.threads.split(",")]
     args.impls = args.impls.split(",")
-    cases = GROUPS.get(args.cases) or args.cases.split(",")
-    for c in cases:
-        if c not in CASES:
-            sys.exit(f"unknown case {c}; known: {', '.join(CASES)}")
+    cases = expand_cases(args.cases)
 
     meta = machine(args)
     hnn, libtorch = build(args)

@@ -46,5 +46,18 @@ class CoreTest(unittest.TestCase):
                       str(e.exception))
 
 
+class CasesTest(unittest.TestCase):
+    def test_groups_and_names_mix_and_each_case_runs_once(self):
+        cases = compare.expand_cases("spring-hnn-f64,peers,chain2-chnn-f32")
+        self.assertEqual(cases[0], "spring-hnn-f64")
+        self.assertEqual(cases[1:], compare.GROUPS["peers"])
+        self.assertEqual(len(cases), len(set(cases)))
+
+    def test_an_unknown_name_is_refused_naming_it(self):
+        with self.assertRaises(SystemExit) as e:
+            compare.expand_cases("peers,spring-hnn-f16")
+        self.assertIn("unknown case spring-hnn-f16", str(e.exception))
+
+
 if __name__ == "__main__":
     unittest.main()
