@@ -54,6 +54,7 @@ struct FloorResult {
 };
 FloorResult floor_score(const ConstrainedSystem& system, const Batch& z0,
                         const std::vector<Batch>& truth, std::mt19937_64& rng, double eps = 1e-4,
-                        double rtol = 1e-10, FloorProjection projection = FloorProjection::kPeer);
+                        double rtol = 1e-10, FloorProjection projection = FloorProjection::kPeer,
+                        const RowParallel& parallel = {});
 
 }  // namespace hnn::physics::constrained

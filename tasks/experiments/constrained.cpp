@@ -14,6 +14,7 @@
 
 #include <cmath>
 
+#include "autodiff/parallel.h"
 #include "nn/constrained/constraints.h"
 #include "physics/constrained/chain_angles.h"
 #include "physics/constrained/metric.h"
@@ -37,6 +38,12 @@ constexpr int kMaxChunkedTrajectories = 100'000;
 // The floor's perturbation draws: one fixed generator, so that every model of a run's seed is
 // measured against the same floor (the starts depend on the seed).
 constexpr std::uint64_t kConstrainedFloorSeed = 0x5eed;
+
+// The truths' rows (each integrated on its own steps) shared among the engine's threads: a run's
+// data, its evaluation's truth and its floor. A gyroscope's data took 14 s on one thread.
+void engine_rows(int parts, const std::function<void(int)>& part) {
+  ad::parallel_for(parts, [&](int i) { part(i); });
+}
 
 // The state a model learns: the system's own, or the chain's angles with canonical momenta
 // (HNN) or angular velocities (LNN, mass HNN).
@@ -170,8 +177,12 @@ class ConstrainedTask : public FieldTask {
     const int test =
         trajectory_count(settings.task_settings, "validation", kValidationTrajectories, name());
     std::mt19937_64 rng(settings.seed);
-    const Batch train_x = chunk_rows(pc::sample_chunks(cartesian_, train, kChunkOutputs, rng));
-    const Batch test_x = chunk_rows(pc::sample_chunks(cartesian_, test, kChunkOutputs, rng));
+    const auto chunks = [&](int count) {
+      return chunk_rows(
+          pc::sample_chunks(cartesian_, count, kChunkOutputs, rng, 1e-10, engine_rows));
+    };
+    const Batch train_x = chunks(train);
+    const Batch test_x = chunks(test);
     Batch train_dxdt, test_dxdt;
     truth().vector_field(train_x, train_dxdt);
     truth().vector_field(test_x, test_dxdt);
@@ -186,7 +197,8 @@ class ConstrainedTask : public FieldTask {
 
   // The peer's test starts: the first states of random chunks of sampled trajectories.
   Batch rollout_states(const Dataset&, int count, std::mt19937_64& rng) const override {
-    pc::ChunkSample sample = pc::sample_chunks(cartesian_, count, kChunkOutputs, rng);
+    pc::ChunkSample sample =
+        pc::sample_chunks(cartesian_, count, kChunkOutputs, rng, 1e-10, engine_rows);
     sample.states.resize(1);
     return in_coordinates(std::move(sample.states)).front();
   }
@@ -209,7 +221,8 @@ class ConstrainedTask : public FieldTask {
     std::vector<Batch> predicted = per_time(r.pred);
     for (Batch& b : predicted) b = to_cartesian(b);
     const Batch z0 = to_cartesian(per_time(r.truth).front());
-    const std::vector<Batch> truth = pc::simulate_constrained(cartesian_, z0, r.t).states;
+    const std::vector<Batch> truth =
+        pc::simulate_constrained(cartesian_, z0, r.t, 1e-10, pc::kTruthAtol, engine_rows).states;
     const double dt = r.t[1] - r.t[0];
     const pc::RolloutScore score =
         pc::score_rollouts(predicted, truth, dt, dt * double(r.t.size()));
@@ -219,7 +232,9 @@ class ConstrainedTask : public FieldTask {
     if (r.t.size() == cartesian_.output_times().size()) {
       std::mt19937_64 rng(kConstrainedFloorSeed);
       metrics["cartesian_error_floor"] =
-          number(pc::floor_score(cartesian_, z0, truth, rng).score.geometric_mean);
+          number(pc::floor_score(cartesian_, z0, truth, rng, 1e-4, 1e-10,
+                                 pc::FloorProjection::kPeer, engine_rows)
+                     .score.geometric_mean);
     } else {
       metrics["cartesian_error_note"] = "no floor: the rollouts' span is not the peer's";
     }

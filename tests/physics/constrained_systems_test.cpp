@@ -3,8 +3,12 @@
 // manifold, and the angle-coordinate chain gives the Cartesian chain's trajectory.
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cmath>
 #include <cstdio>
+#include <functional>
+#include <thread>
+#include <vector>
 
 #include "physics/constrained/chain_angles.h"
 #include "physics/constrained/rigid_bodies.h"
@@ -171,6 +175,34 @@ TEST(ConstrainedTruth, ProjectedFormKeepsAViolationConstantWhereTheMultipliersWo
   const Trajectory path = simulate_constrained(system, z0, {0.0, 1.0, 2.0});
   EXPECT_LT(max_abs(system.constraint_values(path.states.back()) - phi0), 1e-9);
   EXPECT_LT(max_abs(system.constraint_velocities(path.states.back()) - jv0), 1e-8);
+}
+
+TEST(ConstrainedTruth, RowsSharedAmongThreadsGiveTheSameStatesAndSteps) {
+  // The rows as simulate_constrained's parts, on three threads in reverse order: each row is
+  // integrated on its own steps, so nothing may depend on which thread ran it or when.
+  std::atomic<int> ran{0};
+  const RowParallel three_threads = [&ran](int parts, const std::function<void(int)>& part) {
+    std::vector<std::thread> threads;
+    for (int t = 0; t < 3; ++t) {
+      threads.emplace_back([&, t] {
+        for (int i = parts - 1 - t; i >= 0; i -= 3, ++ran) part(i);
+      });
+    }
+    for (std::thread& thread : threads) thread.join();
+  };
+  const ConstrainedSystem system = make_constrained_system("magnet_pendulum");
+  std::mt19937_64 rng(5);
+  const Batch z0 = system.sample_initial_states(7, rng);
+  const std::vector<double> times = system.output_times();
+  const Trajectory serial = simulate_constrained(system, z0, times);
+  const Trajectory shared =
+      simulate_constrained(system, z0, times, 1e-10, kTruthAtol, three_threads);
+  for (std::size_t k = 0; k < times.size(); ++k)
+    ASSERT_EQ(shared.states[k], serial.states[k]) << "at output " << k;
+  EXPECT_EQ(shared.stats.steps, serial.stats.steps);
+  EXPECT_EQ(shared.stats.nfev, serial.stats.nfev);
+  EXPECT_EQ(ran.load(), 7);  // one part per row
+  EXPECT_GT(serial.stats.steps, 7 * 99);
 }
 
 TEST(ConstrainedSystems, PeerParametersAndBadNames) {
