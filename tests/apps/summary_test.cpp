@@ -1,6 +1,7 @@
-// The valid prediction time as `hnn train` and `hnn evaluate` print it (apps/hnn/commands/
-// summary.cpp), from metrics.json's keys: a rollout whose error never passed the threshold counts
-// its whole span, so when every one did the time is the rollouts' length and says so.
+// What `hnn train` and `hnn evaluate` print (apps/hnn/commands/summary.cpp), from metrics.json's
+// keys alone. The valid prediction time: a rollout whose error never passed the threshold counts
+// its whole span, so when every one did the time is the rollouts' length and says so. R² near 1:
+// its distance from 1, which four digits would round away.
 
 #include "apps/hnn/commands/summary.h"
 
@@ -44,6 +45,14 @@ TEST(Summary, AValidTimeOfRolloutsThatAllPassedTheThresholdIsAMeanWithItsError) 
   EXPECT_EQ(rollout_line(rollouts(0, 0)),
             "  rollouts   valid prediction time 1.63 ± 0.058 (until the relative state error "
             "passes 0.1); the truth perturbed by 1e-4: 20");
+}
+
+TEST(Summary, AnRSquaredThatFourDigitsWouldRoundToOneGivesItsDistanceFromOne) {
+  const std::string text = hnn::app::metrics_summary(
+      {{"test_loss", 2.63e-5}, {"train_loss", 3e-5}, {"test_r2", 0.999974}, {"train_r2", 0.9987}});
+  EXPECT_NE(text.find("; R² test 1 - 2.6e-05, train 0.9987\n"), std::string::npos) << text;
+  EXPECT_NE(hnn::app::metrics_summary({{"test_loss", 1.0}, {"test_r2", 1.0}}).find("R² test 1\n"),
+            std::string::npos);
 }
 
 }  // namespace

@@ -108,13 +108,20 @@ std::string fit_line(const json& m) {
          swim_scale_line(*fit) + rcond_line(*fit);
 }
 
-// "  loss     test 3.1e-02 ± 1e-03, train 3e-02 ± 1e-03; R² test 0.998, train 0.999".
+// R² to four digits, or its distance from 1 where four digits would round it to 1: a model
+// whose fit is 1 - 2.6e-05 printed "R² test 1".
+std::string r2_text(double r2) {
+  if (r2 < 1.0 && r2 >= 0.99995) return fmt::format("1 - {:.2g}", 1.0 - r2);
+  return fmt::format("{:.4g}", r2);
+}
+
+// "  loss     test 3.1e-02 ± 1e-03, train 3e-02 ± 1e-03; R² test 0.998, train 1 - 2.6e-05".
 std::string loss_lines(const json& m) {
   std::string line = fmt::format("  loss       test {}, train {}", with_se(m, "test_loss"),
                                  with_se(m, "train_loss"));
   if (const auto r2 = number_at(m, "test_r2")) {
-    line += fmt::format("; R² test {:.4g}", *r2);
-    if (const auto train = number_at(m, "train_r2")) line += fmt::format(", train {:.4g}", *train);
+    line += fmt::format("; R² test {}", r2_text(*r2));
+    if (const auto train = number_at(m, "train_r2")) line += ", train " + r2_text(*train);
   }
   line += "\n";
   if (m.contains("test_loss_standardised")) {
