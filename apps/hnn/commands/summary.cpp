@@ -133,31 +133,35 @@ std::string loss_lines(const json& m) {
   return line;
 }
 
-// The valid prediction time, beside the truth's own (perturbed by 1e-4) where known. Rollouts
-// whose error never passed the threshold count their whole span (censored): when every one did,
-// the time is only the rollouts' length, and the line says so instead of giving it a spread.
-std::string prediction_line(const json& m) {
-  const std::string valid = with_se(m, "valid_prediction_time");
-  if (valid.empty()) return "";
+// The model's valid prediction time. Rollouts whose error never passed the threshold count
+// their whole span (censored): when every one did, the time is only the rollouts' length, and
+// the words say so instead of giving it a spread; when some did, it is a lower bound.
+std::string model_valid_time(const json& m, double count) {
   const double threshold = number_at(m, "valid_prediction_threshold").value_or(NAN);
   const double censored = number_at(m, "valid_prediction_censored").value_or(0);
-  const double count = number_at(m, "valid_prediction_time_count").value_or(0);
-  std::string line;
   if (censored > 0 && censored == count) {
-    line = fmt::format(
-        "  rollouts   valid prediction time: the whole rollout ({:.3g}); the relative state error "
-        "of all {:g} stayed below {:g}",
+    return fmt::format(
+        "valid prediction time: the whole rollout ({:.3g}); the relative state error of all {:g} "
+        "stayed below {:g}",
         *number_at(m, "valid_prediction_time"), count, threshold);
-  } else {
-    line = fmt::format("  rollouts   valid prediction time {}", valid);
-    if (!std::isnan(threshold))
-      line += fmt::format(" (until the relative state error passes {:g})", threshold);
-    if (censored > 0)
-      line += fmt::format(
-          "; {:g} of {:g} rollouts never passed it and count their whole span, "
-          "so it is a lower bound",
-          censored, count);
   }
+  std::string text = "valid prediction time " + with_se(m, "valid_prediction_time");
+  if (!std::isnan(threshold))
+    text += fmt::format(" (until the relative state error passes {:g})", threshold);
+  if (censored > 0) {
+    text += fmt::format(
+        "; {:g} of {:g} rollouts never passed it and count their whole span, so it is a lower "
+        "bound",
+        censored, count);
+  }
+  return text;
+}
+
+// The valid prediction time, beside the truth's own (perturbed by 1e-4) where known.
+std::string prediction_line(const json& m) {
+  if (!number_at(m, "valid_prediction_time")) return "";
+  const double count = number_at(m, "valid_prediction_time_count").value_or(0);
+  std::string line = "  rollouts   " + model_valid_time(m, count);
   if (const auto floor = number_at(m, "valid_prediction_time_floor")) {
     const bool whole = number_at(m, "valid_prediction_floor_censored").value_or(0) == count;
     line += fmt::format("; the truth perturbed by 1e-4: {}{:.3g}",
