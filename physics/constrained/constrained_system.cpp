@@ -218,12 +218,11 @@ Batch ConstrainedSystem::sample_initial_states(int n, std::mt19937_64& rng) cons
 }
 
 Trajectory simulate_constrained(const ConstrainedSystem& system, const Batch& z0,
-                                const std::vector<double>& t_eval, double rtol, double atol,
-                                const RowParallel& parallel) {
-  IntegratorOptions options;
-  options.rtol = rtol;
-  options.atol = atol;
-  const Dopri5 dopri5(options);
+                                const std::vector<double>& t_eval, const TruthOptions& options) {
+  IntegratorOptions tolerances;
+  tolerances.rtol = options.rtol;
+  tolerances.atol = options.atol;
+  const Dopri5 dopri5(tolerances);
   const VectorField field = system.field();
   Trajectory out;
   out.t = t_eval;
@@ -235,8 +234,8 @@ Trajectory simulate_constrained(const ConstrainedSystem& system, const Batch& z0
     stats[static_cast<std::size_t>(r)] = row.stats;
   };
   const auto rows = static_cast<int>(z0.rows());
-  if (parallel) {
-    parallel(rows, integrate_row);
+  if (options.parallel) {
+    options.parallel(rows, integrate_row);
   } else {
     for (int r = 0; r < rows; ++r) integrate_row(r);
   }
@@ -249,7 +248,7 @@ Trajectory simulate_constrained(const ConstrainedSystem& system, const Batch& z0
 }
 
 ChunkSample sample_chunks(const ConstrainedSystem& system, int n, int chunk_len,
-                          std::mt19937_64& rng, double rtol, const RowParallel& parallel) {
+                          std::mt19937_64& rng, const TruthOptions& options) {
   const std::vector<double> times = system.output_times();
   const auto outputs = static_cast<int>(times.size());
   if (chunk_len < 1 || outputs % chunk_len != 0)
@@ -257,8 +256,8 @@ ChunkSample sample_chunks(const ConstrainedSystem& system, int n, int chunk_len,
         fmt::format("sample_chunks: '{}' has {} outputs, not a multiple "
                     "of the chunk length {}",
                     system.name(), outputs, chunk_len));
-  const Trajectory full = simulate_constrained(system, system.sample_initial_states(n, rng), times,
-                                               rtol, kTruthAtol, parallel);
+  const Trajectory full =
+      simulate_constrained(system, system.sample_initial_states(n, rng), times, options);
   std::uniform_int_distribution<int> chunk(0, outputs / chunk_len - 1);
   ChunkSample out;
   out.states.assign(chunk_len, Batch(n, system.dim()));

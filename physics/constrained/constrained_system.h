@@ -124,20 +124,23 @@ class ConstrainedSystem : public System {
 };
 
 /// Runs part(i) for every i in [0, parts), in any order and possibly on several threads at once:
-/// how a caller with threads (the task layer, with the engine's) shares out the rows of
-/// simulate_constrained. Empty: one after another, on the calling thread.
+/// how a caller with threads (the task layer, with the engine's) shares out the rows of a truth.
+/// Empty: one after another, on the calling thread.
 using RowParallel = std::function<void(int parts, const std::function<void(int)>& part)>;
 
-/// The truth's absolute tolerance, beside each caller's rtol.
-inline constexpr double kTruthAtol = 1e-12;
+/// How a truth is integrated: Dopri5's tolerances, and who runs its rows.
+struct TruthOptions {
+  double rtol = 1e-10, atol = 1e-12;
+  RowParallel parallel{};
+};
 
-/// Ground truth: Dopri5 on the projected field at (rtol, atol), states at t_eval. Each row is
-/// integrated on its own steps: in a shared batch the hardest row sets everyone's step (100
+/// Ground truth: Dopri5 on the projected field at the options' tolerances, states at t_eval. Each
+/// row is integrated on its own steps: in a shared batch the hardest row sets everyone's step (100
 /// magnet-pendulum starts: 8,293 shared steps, 7x the time of one row at a time). The rows are
-/// the parts of `parallel`; the states do not depend on how they are shared out.
+/// the parts of options.parallel; the states do not depend on how they are shared out.
 Trajectory simulate_constrained(const ConstrainedSystem& system, const Batch& z0,
-                                const std::vector<double>& t_eval, double rtol = 1e-10,
-                                double atol = kTruthAtol, const RowParallel& parallel = {});
+                                const std::vector<double>& t_eval,
+                                const TruthOptions& options = {});
 
 /// The peer's data states (RigidBodyDataset): n trajectories from the sampler at output_times(),
 /// each cut into consecutive chunks of chunk_len outputs, one chunk kept per trajectory at random.
@@ -149,7 +152,6 @@ struct ChunkSample {
   std::vector<int> first_output;  ///< per row, the index in output_times() of its chunk's start
 };
 ChunkSample sample_chunks(const ConstrainedSystem& system, int n, int chunk_len,
-                          std::mt19937_64& rng, double rtol = 1e-10,
-                          const RowParallel& parallel = {});
+                          std::mt19937_64& rng, const TruthOptions& options = {});
 
 }  // namespace hnn::physics::constrained

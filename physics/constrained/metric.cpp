@@ -58,8 +58,8 @@ RolloutScore score_rollouts(const std::vector<Batch>& predicted, const std::vect
 }
 
 FloorResult floor_score(const ConstrainedSystem& system, const Batch& z0,
-                        const std::vector<Batch>& truth, std::mt19937_64& rng, double eps,
-                        double rtol, FloorProjection projection, const RowParallel& parallel) {
+                        const std::vector<Batch>& truth, std::mt19937_64& rng,
+                        const TruthOptions& options, double eps, FloorProjection projection) {
   const std::vector<double> times = system.output_times();
   if (truth.size() != times.size() || truth.front().rows() != z0.rows())
     throw std::invalid_argument(fmt::format(
@@ -71,7 +71,7 @@ FloorResult floor_score(const ConstrainedSystem& system, const Batch& z0,
   const Batch start =
       projection == FloorProjection::kPeer ? system.project_peer(moved) : system.project(moved);
   FloorResult result;
-  result.perturbed = simulate_constrained(system, start, times, rtol, kTruthAtol, parallel).states;
+  result.perturbed = simulate_constrained(system, start, times, options).states;
   result.score = score_rollouts(result.perturbed, truth, system.spec().dt, system.spec().horizon);
   return result;
 }

@@ -44,17 +44,17 @@ enum class FloorProjection {
 };
 
 /// The floor: each start moved by eps N(0, 1) per component, projected back onto the manifold,
-/// the truth integrated from it (simulate_constrained at rtol), and this perturbed truth scored
-/// against the truth, which must be at system.output_times(). The projection changes the floor
-/// (over 100 two-link chain starts: 6.0e-5 with the peer's, 8.5e-5 M-weighted; the peer
+/// the truth integrated from it (simulate_constrained with `options`), and this perturbed truth
+/// scored against the truth, which must be at system.output_times(). The projection changes the
+/// floor (over 100 two-link chain starts: 6.0e-5 with the peer's, 8.5e-5 M-weighted; the peer
 /// published 5.9e-5), so the peer's is the default. Returns the perturbed states too.
 struct FloorResult {
   RolloutScore score;
   std::vector<Batch> perturbed;
 };
 FloorResult floor_score(const ConstrainedSystem& system, const Batch& z0,
-                        const std::vector<Batch>& truth, std::mt19937_64& rng, double eps = 1e-4,
-                        double rtol = 1e-10, FloorProjection projection = FloorProjection::kPeer,
-                        const RowParallel& parallel = {});
+                        const std::vector<Batch>& truth, std::mt19937_64& rng,
+                        const TruthOptions& options = {}, double eps = 1e-4,
+                        FloorProjection projection = FloorProjection::kPeer);
 
 }  // namespace hnn::physics::constrained

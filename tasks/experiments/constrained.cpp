@@ -39,11 +39,13 @@ constexpr int kMaxChunkedTrajectories = 100'000;
 // measured against the same floor (the starts depend on the seed).
 constexpr std::uint64_t kConstrainedFloorSeed = 0x5eed;
 
-// The truths' rows (each integrated on its own steps) shared among the engine's threads: a run's
-// data, its evaluation's truth and its floor. A gyroscope's data took 14 s on one thread.
-void engine_rows(int parts, const std::function<void(int)>& part) {
-  ad::parallel_for(parts, [&](int i) { part(i); });
-}
+// The truths (a run's data, its evaluation's truth and its floor) at the default tolerances, their
+// rows (each integrated on its own steps) shared among the engine's threads. A gyroscope's data
+// took 14 s on one thread.
+const pc::TruthOptions kOnEngineThreads{
+    .parallel = [](int parts, const std::function<void(int)>& part) {
+      ad::parallel_for(parts, part);
+    }};
 
 // The state a model learns: the system's own, or the chain's angles with canonical momenta
 // (HNN) or angular velocities (LNN, mass HNN).
@@ -178,8 +180,7 @@ class ConstrainedTask : public FieldTask {
         trajectory_count(settings.task_settings, "validation", kValidationTrajectories, name());
     std::mt19937_64 rng(settings.seed);
     const auto chunks = [&](int count) {
-      return chunk_rows(
-          pc::sample_chunks(cartesian_, count, kChunkOutputs, rng, 1e-10, engine_rows));
+      return chunk_rows(pc::sample_chunks(cartesian_, count, kChunkOutputs, rng, kOnEngineThreads));
     };
     const Batch train_x = chunks(train);
     const Batch test_x = chunks(test);
@@ -198,7 +199,7 @@ class ConstrainedTask : public FieldTask {
   // The peer's test starts: the first states of random chunks of sampled trajectories.
   Batch rollout_states(const Dataset&, int count, std::mt19937_64& rng) const override {
     pc::ChunkSample sample =
-        pc::sample_chunks(cartesian_, count, kChunkOutputs, rng, 1e-10, engine_rows);
+        pc::sample_chunks(cartesian_, count, kChunkOutputs, rng, kOnEngineThreads);
     sample.states.resize(1);
     return in_coordinates(std::move(sample.states)).front();
   }
@@ -222,7 +223,7 @@ class ConstrainedTask : public FieldTask {
     for (Batch& b : predicted) b = to_cartesian(b);
     const Batch z0 = to_cartesian(per_time(r.truth).front());
     const std::vector<Batch> truth =
-        pc::simulate_constrained(cartesian_, z0, r.t, 1e-10, pc::kTruthAtol, engine_rows).states;
+        pc::simulate_constrained(cartesian_, z0, r.t, kOnEngineThreads).states;
     const double dt = r.t[1] - r.t[0];
     const pc::RolloutScore score =
         pc::score_rollouts(predicted, truth, dt, dt * double(r.t.size()));
@@ -231,10 +232,8 @@ class ConstrainedTask : public FieldTask {
     metrics["cartesian_error_rollouts"] = int(z0.rows());
     if (r.t.size() == cartesian_.output_times().size()) {
       std::mt19937_64 rng(kConstrainedFloorSeed);
-      metrics["cartesian_error_floor"] =
-          number(pc::floor_score(cartesian_, z0, truth, rng, 1e-4, 1e-10,
-                                 pc::FloorProjection::kPeer, engine_rows)
-                     .score.geometric_mean);
+      metrics["cartesian_error_floor"] = number(
+          pc::floor_score(cartesian_, z0, truth, rng, kOnEngineThreads).score.geometric_mean);
     } else {
       metrics["cartesian_error_note"] = "no floor: the rollouts' span is not the peer's";
     }

@@ -195,8 +195,7 @@ TEST(ConstrainedTruth, RowsSharedAmongThreadsGiveTheSameStatesAndSteps) {
   const Batch z0 = system.sample_initial_states(7, rng);
   const std::vector<double> times = system.output_times();
   const Trajectory serial = simulate_constrained(system, z0, times);
-  const Trajectory shared =
-      simulate_constrained(system, z0, times, 1e-10, kTruthAtol, three_threads);
+  const Trajectory shared = simulate_constrained(system, z0, times, {.parallel = three_threads});
   for (std::size_t k = 0; k < times.size(); ++k)
     ASSERT_EQ(shared.states[k], serial.states[k]) << "at output " << k;
   EXPECT_EQ(shared.stats.steps, serial.stats.steps);
