@@ -7,8 +7,10 @@
 //
 // The baseline learns the Cartesian state z = (x, v). On the chains the HNN learns the angle twin
 // (theta, p), the LNN and the mass HNN (their HNN) (theta, omega) (physics/constrained/
-// chain_angles.h); their rollouts are mapped to Cartesian (x, v) before the metric, so every model
-// is scored alike.
+// chain_angles.h); on the other systems the LNN and the mass HNN learn their body coordinates
+// with their rates (q, dq/dt) (body_coordinates.h: spherical or Euler angles, a free body's
+// centre), as the peer's HNN does. Every rollout is mapped to Cartesian (x, v) before the metric,
+// so every model is scored alike.
 
 #include <fmt/format.h>
 
@@ -16,6 +18,7 @@
 
 #include "autodiff/parallel.h"
 #include "nn/constrained/constraints.h"
+#include "physics/constrained/body_coordinates.h"
 #include "physics/constrained/chain_angles.h"
 #include "physics/constrained/metric.h"
 #include "physics/constrained/systems.h"
@@ -48,7 +51,7 @@ const pc::TruthOptions kOnEngineThreads{
     }};
 
 // The state a model learns: the system's own, or the chain's angles with canonical momenta
-// (HNN) or angular velocities (LNN, mass HNN).
+// (HNN), or the chain's angles or a body's coordinates with their rates (LNN, mass HNN).
 enum class Coordinates { kCartesian, kAngles, kAngleVelocities };
 
 Coordinates model_coordinates(nn::ModelKind model) {
@@ -60,7 +63,7 @@ Coordinates model_coordinates(nn::ModelKind model) {
 struct ConstrainedEntry {
   const char* task;
   const char* system;  // physics/constrained/systems.h
-  int links;           // 0: not a chain (no angle twin)
+  int links;           // 0: not a chain (body coordinates, no canonical twin)
   const char* summary;
 };
 
@@ -103,10 +106,13 @@ class ConstrainedTask : public FieldTask {
     if (entry.links > 0) {
       angles_ = std::make_unique<pc::ChainPendulumAngles>(entry.links);
       velocities_ = std::make_unique<pc::ChainPendulumVelocities>(entry.links);
+    } else {
+      body_ = std::make_unique<pc::BodyCoordinates>(cartesian_);
     }
-    // The registered task (Cartesian) opens the angle models' runs through its twins.
-    if (coordinates == Coordinates::kCartesian && entry.links > 0) {
-      angle_twin_ = std::make_unique<ConstrainedTask>(entry, Coordinates::kAngles);
+    // The registered task (Cartesian) opens the other models' runs through its twins.
+    if (coordinates == Coordinates::kCartesian) {
+      if (entry.links > 0)
+        angle_twin_ = std::make_unique<ConstrainedTask>(entry, Coordinates::kAngles);
       velocity_twin_ = std::make_unique<ConstrainedTask>(entry, Coordinates::kAngleVelocities);
     }
   }
@@ -141,35 +147,43 @@ class ConstrainedTask : public FieldTask {
   }
   std::vector<nn::ModelKind> models() const override {
     using nn::ModelKind;
-    if (entry_.links == 0) return {ModelKind::kBaseline, ModelKind::kChnn, ModelKind::kClnn};
+    if (entry_.links == 0) {
+      return {ModelKind::kBaseline, ModelKind::kMassHnn, ModelKind::kLnn, ModelKind::kChnn,
+              ModelKind::kClnn};
+    }
     return {ModelKind::kBaseline, ModelKind::kHnn,  ModelKind::kMassHnn,
             ModelKind::kLnn,      ModelKind::kChnn, ModelKind::kClnn};
   }
   nn::ConstraintSpec constraints() const override { return model_constraints(cartesian_.spec()); }
   std::string refusal_reason(nn::ModelKind model) const override {
-    if (model_coordinates(model) == Coordinates::kCartesian) return "";
+    if (model_coordinates(model) != Coordinates::kAngles || entry_.links > 0) return "";
     return fmt::format(
-        ": an {} learns this system in angle coordinates, which hnn has for the chain pendulums "
-        "only (physics/constrained/chain_angles.h), not for the {}",
+        ": an {} learns canonical momenta in angle coordinates, which hnn has for the chain "
+        "pendulums only (physics/constrained/chain_angles.h), not for the {}; the peer's HNN "
+        "(--model hnn-mass) and the LNN learn it in body coordinates (q, dq/dt)",
         nn::to_string(model), entry_.system);
   }
   std::vector<std::string> own_setting_names() const override {
     return {"trajectories", "validation"};
   }
   Eigen::Index angle_coordinates() const override {
-    return coordinates_ == Coordinates::kCartesian ? 0 : entry_.links;
+    if (coordinates_ == Coordinates::kCartesian) return 0;
+    return entry_.links > 0 ? entry_.links : body_->angles();
   }
 
   std::unique_ptr<TaskRun> open(const RunSettings& settings) const override {
     const Coordinates c = model_coordinates(settings.model);
-    if (c == coordinates_ || entry_.links == 0) return FieldTask::open(settings);
+    if (c == coordinates_) return FieldTask::open(settings);
     const ConstrainedTask& twin = c == Coordinates::kAngles ? *angle_twin_ : *velocity_twin_;
     return twin.FieldTask::open(settings);
   }
 
   const physics::System& truth() const override {
     if (coordinates_ == Coordinates::kAngles) return *angles_;
-    if (coordinates_ == Coordinates::kAngleVelocities) return *velocities_;
+    if (coordinates_ == Coordinates::kAngleVelocities) {
+      if (body_) return *body_;
+      return *velocities_;
+    }
     return cartesian_;
   }
 
@@ -239,6 +253,7 @@ class ConstrainedTask : public FieldTask {
     }
     metrics["coordinates"] = coordinates_ == Coordinates::kCartesian ? "cartesian"
                              : coordinates_ == Coordinates::kAngles  ? "angles (theta, p)"
+                             : body_                                 ? "body coordinates (q, dq/dt)"
                                                                      : "angles (theta, omega)";
   }
 
@@ -262,7 +277,8 @@ class ConstrainedTask : public FieldTask {
   // Cartesian (x, v) rows of states in this task's coordinates.
   Batch to_cartesian(const Batch& x) const {
     if (coordinates_ == Coordinates::kAngles) return angles_->to_cartesian(x);
-    if (coordinates_ == Coordinates::kAngleVelocities) return velocities_->to_cartesian(x);
+    if (coordinates_ == Coordinates::kAngleVelocities)
+      return body_ ? body_->to_cartesian(x) : velocities_->to_cartesian(x);
     return x;
   }
 
@@ -271,6 +287,11 @@ class ConstrainedTask : public FieldTask {
   // time (a chunk crossing theta = pi carries no 2 pi jump).
   std::vector<Batch> in_coordinates(std::vector<Batch> states) const {
     if (coordinates_ == Coordinates::kCartesian) return states;
+    if (body_) {
+      for (Batch& b : states) b = body_->from_cartesian(b);
+      pc::unwrap_angles(states, body_->angles());
+      return states;
+    }
     for (Batch& b : states) b = pc::chain_angles(entry_.links, b);
     pc::unwrap_angles(states, entry_.links);
     if (coordinates_ == Coordinates::kAngles)
@@ -304,6 +325,7 @@ class ConstrainedTask : public FieldTask {
   pc::ConstrainedSystem cartesian_;
   std::unique_ptr<pc::ChainPendulumAngles> angles_;
   std::unique_ptr<pc::ChainPendulumVelocities> velocities_;
+  std::unique_ptr<pc::BodyCoordinates> body_;  // the systems that are not chains
   std::unique_ptr<ConstrainedTask> angle_twin_, velocity_twin_;
 };
 

@@ -162,6 +162,7 @@ class Options(CompareCase):
             for model in ("baseline", "hnn", "hnn-mass", "lnn", "chnn", "clnn"):
                 self.assertIn(f"{task} {model} rollout: 3 runs", lines)
         self.assertIn("gyroscope chnn rollout: 3 runs", lines)
+        self.assertIn("rotor hnn-mass rollout: 3 runs", lines)  # their HNN, in body coordinates
         self.assertTrue(any(l.startswith("gyroscope hnn rollout: skipped: ") for l in lines))
         # their data efficiency: 10 trajectories, so a batch of all 10 chunks, 2000 steps
         self.assertIn('chain-pendulum-2 chnn rollout {"settings":{"trajectories":10},"batch":10,'

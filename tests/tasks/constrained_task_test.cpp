@@ -1,7 +1,7 @@
 // The constrained systems' tasks (tasks/experiments/constrained.cpp): Finzi et al.'s data (one
 // 5-output chunk per trajectory), a run end to end with their metric, its floor and the failed
-// rollouts; an angle model's rollouts scored in Cartesian coordinates; the refusals; and the
-// task's default loss (RK4 over the chunk, L1) with the keys that change it.
+// rollouts; an angle or body-coordinate model's rollouts scored in Cartesian coordinates; the
+// refusals; and the task's default loss (RK4 over the chunk, L1) with the keys that change it.
 
 #include <gtest/gtest.h>
 
@@ -11,6 +11,7 @@
 #include "nn/constrained/constrained_model.h"
 #include "nn/constrained/masses.h"
 #include "nn/mass_hnn.h"
+#include "physics/constrained/body_coordinates.h"
 #include "physics/constrained/chain_angles.h"
 #include "physics/constrained/metric.h"
 #include "physics/constrained/systems.h"
@@ -244,17 +245,52 @@ TEST(ConstrainedTask, TheConstrainedModelsLearnTheirMassesWhenAsked) {
   EXPECT_FALSE(std::filesystem::exists(dir / "h"));
 }
 
-TEST(ConstrainedTask, RefusesAngleModelsWhereHnnHasNoAngles) {
+// Off the chains, their HNN and the LNN learn the body coordinates with their rates (the
+// gyroscope's Euler angles): the run says so, its rollouts are scored in Cartesian coordinates
+// through the body's map, and the free HNN, which needs canonical momenta in angles, is refused
+// saying where hnn has them.
+TEST(ConstrainedTask, OffTheChainsTheirHnnLearnsBodyCoordinates) {
   TempDir dir("runs");
-  for (const char* model : {"hnn", "hnn-mass", "lnn"}) {
-    try {
-      run_training(tiny(model, dir / model, "gyroscope"));
-      FAIL() << model << " accepted";
-    } catch (const Error& e) {
-      EXPECT_NE(std::string(e.what()).find("angle coordinates"), std::string::npos) << e.what();
-    }
-    EXPECT_FALSE(std::filesystem::exists(dir / model));
+  for (const char* model : {"hnn-mass", "lnn"}) {
+    SCOPED_TRACE(model);
+    const nlohmann::json m = run_training(tiny(model, dir / model, "gyroscope"));
+    EXPECT_EQ(m["coordinates"], "body coordinates (q, dq/dt)");
+    const LoadedRun loaded = load_run(dir / model);
+    const Batch x0 = loaded.run->rollout_states(2);
+    ASSERT_EQ(x0.cols(), 6);  // three Euler angles and their rates
+    const pc::BodyCoordinates body(pc::make_constrained_system("gyroscope"));
+    const std::vector<double> t = body.cartesian().output_times();
+    const Rollouts r = make_rollouts(body, loaded.run->dynamics(), x0,
+                                     {.t_end = t.back(),
+                                      .points = int(t.size()),
+                                      .rtol = 1e-7,
+                                      .atol = 1e-9,
+                                      .perturbation = 0});
+    std::vector<Batch> predicted(t.size(), Batch(2, 24));
+    for (std::size_t k = 0; k < t.size(); ++k)
+      for (Eigen::Index i = 0; i < 2; ++i)
+        predicted[k].row(i) =
+            body.to_cartesian(Batch(r.pred[std::size_t(i)].row(Eigen::Index(k)))).row(0);
+    const std::vector<Batch> truth =
+        pc::simulate_constrained(body.cartesian(), body.to_cartesian(x0), t).states;
+    const pc::RolloutScore score = pc::score_rollouts(predicted, truth, 0.02, 2.0);
+    EXPECT_NEAR(m["cartesian_error"].get<double>(), score.geometric_mean,
+                1e-9 * score.geometric_mean);
   }
+  try {
+    run_training(tiny("hnn", dir / "hnn", "gyroscope"));
+    FAIL() << "hnn accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("canonical momenta in angle coordinates"),
+              std::string::npos)
+        << e.what();
+    EXPECT_NE(std::string(e.what()).find("--model hnn-mass"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir / "hnn"));
+}
+
+TEST(ConstrainedTask, RefusesAZeroTrajectoryCount) {
+  TempDir dir("runs");
   RunOptions o = tiny("baseline", dir / "bad");
   o.task_settings["trajectories"] = 0;
   EXPECT_THROW(run_training(o), Error);

@@ -59,17 +59,17 @@ std::vector<Group> default_study() {
 
 // Finzi et al.'s constrained systems at their protocol, each task's default (8,000 steps through
 // RK4 over 5-output chunks, L1): the chains in angles for the HNN, their HNN (hnn-mass) and the
-// LNN, in Cartesian coordinates for the baseline, CHNN and CLNN; the rigid bodies Cartesian only
-// (an HNN there is a row saying why it is skipped, beside the peer's HNN). Each run trains a 3 x
-// 256 network for
-// 8,000 steps through RK4 and solves the constraints' multipliers at every stage, so this is a
-// study of its own, not the default's (docs/tasks.md, "Constrained systems").
+// LNN, in Cartesian coordinates for the baseline, CHNN and CLNN; the other systems in their body
+// coordinates for their HNN (the free HNN there is a row saying why it is skipped), Cartesian for
+// the baseline and CHNN. Each run trains a 3 x 256 network for 8,000 steps through RK4 and solves
+// the constraints' multipliers (or a mass matrix) at every stage, so this is a study of its own,
+// not the default's (docs/tasks.md, "Constrained systems").
 std::vector<Group> constrained_study() {
   Group chains = crossed({"chain-pendulum-2", "chain-pendulum-3", "chain-pendulum-5"},
                          {"baseline", "hnn", "hnn-mass", "lnn", "chnn", "clnn"}, {"rollout"});
   chains.metrics = {"cartesian_error_floor", "cartesian_error_failed"};
   Group bodies = crossed({"gyroscope", "rotor", "magnet-pendulum", "coupled-pendulums"},
-                         {"baseline", "hnn", "chnn"}, {"rollout"});
+                         {"baseline", "hnn", "hnn-mass", "chnn"}, {"rollout"});
   bodies.metrics = chains.metrics;
   // Their data efficiency: 10 training trajectories instead of 800, so their batch of
   // min(200, trajectories) is all 10 chunks and their 2000 epochs are 2000 steps.
