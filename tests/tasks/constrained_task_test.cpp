@@ -86,6 +86,26 @@ TEST(ConstrainedTask, RunsEndToEndWithTheMetricItsFloorAndTheFailedCount) {
   EXPECT_EQ(m["training"]["horizon"], 4);
 }
 
+// A run's rollouts from x0 in its own coordinates (those of `twin`, a System with to_cartesian),
+// mapped to Cartesian (x, v) and scored against the Cartesian truth: the metric recomputed.
+template <typename Twin>
+pc::RolloutScore rescored(const Twin& twin, const LoadedRun& loaded, const Batch& x0) {
+  const pc::ConstrainedSystem& cartesian = twin.cartesian();
+  const std::vector<double> t = cartesian.output_times();
+  const Rollouts r = make_rollouts(
+      twin, loaded.run->dynamics(), x0,
+      {.t_end = t.back(), .points = int(t.size()), .rtol = 1e-7, .atol = 1e-9, .perturbation = 0});
+  std::vector<Batch> predicted(t.size(), Batch(x0.rows(), cartesian.dim()));
+  for (std::size_t k = 0; k < t.size(); ++k)
+    for (Eigen::Index i = 0; i < x0.rows(); ++i)
+      predicted[k].row(i) =
+          twin.to_cartesian(Batch(r.pred[std::size_t(i)].row(Eigen::Index(k)))).row(0);
+  const std::vector<Batch> truth =
+      pc::simulate_constrained(cartesian, twin.to_cartesian(x0), t).states;
+  const double dt = cartesian.spec().dt;
+  return pc::score_rollouts(predicted, truth, dt, dt * double(t.size()));
+}
+
 TEST(ConstrainedTask, AnAngleModelIsScoredInCartesianCoordinates) {
   TempDir dir("runs");
   const nlohmann::json m = run_training(tiny("hnn", dir / "h"));
@@ -93,20 +113,7 @@ TEST(ConstrainedTask, AnAngleModelIsScoredInCartesianCoordinates) {
   const LoadedRun loaded = load_run(dir / "h");
   const Batch x0 = loaded.run->rollout_states(2);
   ASSERT_EQ(x0.cols(), 4);  // (theta, p) of two links
-  // The model's rollouts in angles, mapped to Cartesian, against the Cartesian truth.
-  const pc::ChainPendulumAngles angles(2);
-  const std::vector<double> t = angles.cartesian().output_times();
-  const Rollouts r = make_rollouts(
-      angles, loaded.run->dynamics(), x0,
-      {.t_end = t.back(), .points = int(t.size()), .rtol = 1e-7, .atol = 1e-9, .perturbation = 0});
-  std::vector<Batch> predicted(t.size(), Batch(2, 8));
-  for (std::size_t k = 0; k < t.size(); ++k)
-    for (Eigen::Index i = 0; i < 2; ++i)
-      predicted[k].row(i) =
-          angles.to_cartesian(Batch(r.pred[std::size_t(i)].row(Eigen::Index(k)))).row(0);
-  const std::vector<Batch> truth =
-      pc::simulate_constrained(angles.cartesian(), angles.to_cartesian(x0), t).states;
-  const pc::RolloutScore score = pc::score_rollouts(predicted, truth, 0.03, 3.0);
+  const pc::RolloutScore score = rescored(pc::ChainPendulumAngles(2), loaded, x0);
   EXPECT_NEAR(m["cartesian_error"].get<double>(), score.geometric_mean,
               1e-9 * score.geometric_mean);
   EXPECT_EQ(m["cartesian_error_failed"], score.failed);
@@ -258,22 +265,8 @@ TEST(ConstrainedTask, OffTheChainsTheirHnnLearnsBodyCoordinates) {
     const LoadedRun loaded = load_run(dir / model);
     const Batch x0 = loaded.run->rollout_states(2);
     ASSERT_EQ(x0.cols(), 6);  // three Euler angles and their rates
-    const pc::BodyCoordinates body(pc::make_constrained_system("gyroscope"));
-    const std::vector<double> t = body.cartesian().output_times();
-    const Rollouts r = make_rollouts(body, loaded.run->dynamics(), x0,
-                                     {.t_end = t.back(),
-                                      .points = int(t.size()),
-                                      .rtol = 1e-7,
-                                      .atol = 1e-9,
-                                      .perturbation = 0});
-    std::vector<Batch> predicted(t.size(), Batch(2, 24));
-    for (std::size_t k = 0; k < t.size(); ++k)
-      for (Eigen::Index i = 0; i < 2; ++i)
-        predicted[k].row(i) =
-            body.to_cartesian(Batch(r.pred[std::size_t(i)].row(Eigen::Index(k)))).row(0);
-    const std::vector<Batch> truth =
-        pc::simulate_constrained(body.cartesian(), body.to_cartesian(x0), t).states;
-    const pc::RolloutScore score = pc::score_rollouts(predicted, truth, 0.02, 2.0);
+    const pc::RolloutScore score =
+        rescored(pc::BodyCoordinates(pc::make_constrained_system("gyroscope")), loaded, x0);
     EXPECT_NEAR(m["cartesian_error"].get<double>(), score.geometric_mean,
                 1e-9 * score.geometric_mean);
   }
