@@ -182,7 +182,7 @@ TEST(BatchedSolve, SingularBlockThrowsNamingItsRow) {
 
 TEST(BatchedSolve, IllConditionedBlockThrowsAndItsEstimateIsReported) {
   MatrixD a = WellConditionedBlocks(3, 2, 9);
-  a.row(1) << 1, 1, 1, 1 + 1e-15;  // cond ~ 4e15: rcond ~ 2.5e-16 < 2.2e-13
+  a.row(1) << 1, 1, 1, 1 + 1e-15;  // cond ~ 4e15: rcond ~ 2.5e-16 < 2.2e-14
   const std::string message = ErrorOf([&] {
     ad::TapeScope scope;
     ad::batched_solve(VarD::constant(a), VarD::constant(random_matrix(3, 2, 10)), true);
@@ -192,7 +192,7 @@ TEST(BatchedSolve, IllConditionedBlockThrowsAndItsEstimateIsReported) {
 }
 
 TEST(BatchedSolve, ThresholdIsPerPrecision) {
-  // cond ~ 4e5: fine in double, refused in float (1000 eps = 1.2e-4 > rcond ~ 2.5e-6).
+  // cond ~ 4e5: fine in double, refused in float (100 eps = 1.2e-5 > rcond ~ 2.5e-6).
   MatrixD a(1, 4);
   a << 1, 1, 1, 1 + 1e-5;
   const MatrixD b = random_matrix(1, 2, 11);
