@@ -115,13 +115,15 @@ TEST(LnnOnATaskWithoutVelocities, GetsOneLineSayingWhyAndWhere) {
       EXPECT_NE(
           what.find("from coordinates and their velocities, which this task's states are "
                     "not (tasks that have them: double-pendulum, real-double-pendulum, "
-                    "chain-pendulum-2, chain-pendulum-3, chain-pendulum-4, chain-pendulum-5)"),
+                    "chain-pendulum-2, chain-pendulum-3, chain-pendulum-4, chain-pendulum-5, "
+                    "coupled-pendulums, magnet-pendulum, gyroscope, rotor)"),
           std::string::npos)
           << what;
     }
     EXPECT_FALSE(std::filesystem::exists(dir / task));
   }
-  // Finzi et al.'s HNN learns its mass matrix from velocities too: the chains' angle twins.
+  // Finzi et al.'s HNN learns its mass matrix from velocities too: the chains' angle twins and
+  // the other constrained systems' body coordinates.
   try {
     run_training(testing::small_run("spring", "hnn-mass", dir / "mass", 5));
     FAIL() << "spring accepted an hnn-mass";
@@ -129,7 +131,8 @@ TEST(LnnOnATaskWithoutVelocities, GetsOneLineSayingWhyAndWhere) {
     EXPECT_NE(std::string(e.what()).find(
                   "an hnn-mass learns from coordinates and their velocities, which this task's "
                   "states are not (tasks that have them: chain-pendulum-2, chain-pendulum-3, "
-                  "chain-pendulum-4, chain-pendulum-5)"),
+                  "chain-pendulum-4, chain-pendulum-5, coupled-pendulums, magnet-pendulum, "
+                  "gyroscope, rotor)"),
               std::string::npos)
         << e.what();
   }
