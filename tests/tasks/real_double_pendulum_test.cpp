@@ -112,12 +112,11 @@ TEST(LnnOnATaskWithoutVelocities, GetsOneLineSayingWhyAndWhere) {
       EXPECT_NE(what.find(fmt::format("task '{}' does not train a lnn model", task)),
                 std::string::npos)
           << what;
-      EXPECT_NE(
-          what.find("from coordinates and their velocities, which this task's states are "
-                    "not (tasks that have them: double-pendulum, real-double-pendulum, "
-                    "chain-pendulum-2, chain-pendulum-3, chain-pendulum-4, chain-pendulum-5, "
-                    "coupled-pendulums, magnet-pendulum, gyroscope, rotor)"),
-          std::string::npos)
+      EXPECT_NE(what.find("from coordinates and their velocities, which this task's states are "
+                          "not (tasks that have them: double-pendulum, real-double-pendulum, "
+                          "chain-pendulum-2, chain-pendulum-3, chain-pendulum-4, chain-pendulum-5, "
+                          "coupled-pendulums, magnet-pendulum, gyroscope, rotor)"),
+                std::string::npos)
           << what;
     }
     EXPECT_FALSE(std::filesystem::exists(dir / task));
