@@ -185,14 +185,16 @@ Eigen::MatrixXd BodyCoordinates::jacobian(const Eigen::VectorXd& q) const {
   return j;
 }
 
-Batch BodyCoordinates::to_cartesian(const BatchView& x) const {
+Batch BodyCoordinates::to_cartesian(const BatchView& x, Batch* curvature) const {
   const int n = map_.dof, nd = cartesian_.configuration_dim();
   Batch z(x.rows(), 2 * nd);
+  if (curvature) curvature->resize(x.rows(), nd);
   for (Eigen::Index r = 0; r < x.rows(); ++r) {
     const PositionJet p =
         map_.positions(x.row(r).head(n).transpose(), x.row(r).tail(n).transpose());
     z.row(r).head(nd) = p.x0.transpose();
     z.row(r).tail(nd) = p.x1.transpose();
+    if (curvature) curvature->row(r) = 2.0 * p.x2.transpose();
   }
   return z;
 }
@@ -218,15 +220,16 @@ Eigen::VectorXd BodyCoordinates::hamiltonian_batch(const BatchView& x) const {
 
 void BodyCoordinates::vector_field(const BatchView& x, Batch& dxdt) const {
   const int n = map_.dof;
-  const Batch z = to_cartesian(x);
+  Batch curvature;  // f''[qdot, qdot] per row, from the same Jets as the positions
+  const Batch z = to_cartesian(x, &curvature);
   const Batch a = cartesian_.acceleration(z);
   dxdt.resize(x.rows(), 2 * n);
   for (Eigen::Index r = 0; r < x.rows(); ++r) {
-    const Eigen::VectorXd q = x.row(r).head(n).transpose(), qdot = x.row(r).tail(n).transpose();
-    // a = J qddot + f''[qdot, qdot] = J qddot + 2 x2.
-    const Eigen::VectorXd rest = a.row(r).transpose() - 2.0 * map_.positions(q, qdot).x2;
-    dxdt.row(r).head(n) = qdot.transpose();
-    dxdt.row(r).tail(n) = jacobian(q).colPivHouseholderQr().solve(rest).transpose();
+    // a = J qddot + f''[qdot, qdot].
+    const Eigen::VectorXd rest = (a.row(r) - curvature.row(r)).transpose();
+    dxdt.row(r).head(n) = x.row(r).tail(n);
+    dxdt.row(r).tail(n) =
+        jacobian(x.row(r).head(n).transpose()).colPivHouseholderQr().solve(rest).transpose();
   }
 }
 

@@ -50,8 +50,9 @@ class BodyCoordinates : public System {
   /// The Cartesian system's sampler mapped to (q, qdot).
   Batch sample_initial_states(int n, std::mt19937_64& rng) const override;
 
-  /// (q, qdot) rows -> Cartesian (x, v) rows.
-  Batch to_cartesian(const BatchView& x) const;
+  /// (q, qdot) rows -> Cartesian (x, v) rows; with `curvature`, also each row's f''[qdot, qdot]
+  /// (the positions' acceleration at qddot = 0), from the same pass.
+  Batch to_cartesian(const BatchView& x, Batch* curvature = nullptr) const;
   /// Cartesian (x, v) rows on the manifold -> (q, qdot), qdot = J^+ v.
   Batch from_cartesian(const Batch& z) const;
   const ConstrainedSystem& cartesian() const { return cartesian_; }
