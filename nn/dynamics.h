@@ -132,6 +132,15 @@ class DynamicsModel : public Module<T> {
   virtual bool has_learned_energy() const { return false; }
   virtual Matrix<T> learned_energy(const MatrixView<T>& x) const;
 
+  /// The state a fixed-step integrator carries (tasks/integrate/integrator_step.h) for states
+  /// x as observed, its field, and the observed states of carried ones; all on the tape. For
+  /// every model but the mass HNN the carried state is x itself and its field time_derivative.
+  /// The mass HNN carries (q, p), solving p = M(q) v once at the start, as Finzi et al.'s
+  /// HNN.integrate does: training through its steps then learns what theirs learns.
+  virtual ad::Var<T> integrated_state(const ad::Var<T>& x) const { return x; }
+  virtual ad::Var<T> integrated_derivative(const ad::Var<T>& z) const { return time_derivative(z); }
+  virtual ad::Var<T> observed_state(const ad::Var<T>& z) const { return z; }
+
   const DynamicsConfig& config() const { return config_; }
   Index dim() const { return config_.dim; }
   const Mlp<T>& mlp() const { return mlp_; }

@@ -139,6 +139,21 @@ typename MassHnn<T>::Factor MassHnn<T>::factor(const ad::Var<T>& raw) const {
 }
 
 template <typename T>
+typename MassHnn<T>::Factor MassHnn<T>::factor_at(const ad::Var<T>& q) const {
+  return factor(factor_.forward(this->position_input(q)));
+}
+
+template <typename T>
+ad::Var<T> MassHnn<T>::momentum_rate(const ad::Var<T>& q, const ad::Var<T>& in,
+                                     const std::vector<ad::Var<T>>& hidden, const Factor& k,
+                                     const ad::Var<T>& p, const ad::Var<T>& u) const {
+  // V's gradient and the kinetic term's, 1/2 |L^T p|^2 having p u^T in L.
+  const ad::Var<T> kinetic_gradient =
+      layers_cotangent(factor_, hidden, ad::batched_outer(p, u) * k.slope);
+  return -this->position_gradient(q, this->mlp_.input_gradient(in, 0) + kinetic_gradient);
+}
+
+template <typename T>
 ad::Var<T> MassHnn<T>::time_derivative(const ad::Var<T>& x) const {
   this->check_input("time_derivative", x.rows(), x.cols());
   const Index n = x.cols() / 2;
@@ -148,17 +163,43 @@ ad::Var<T> MassHnn<T>::time_derivative(const ad::Var<T>& x) const {
   const Factor k = factor(layers_forward(factor_, in, hidden));
   const ad::Var<T> p = ad::batched_spd_solve(k.minv, v);
   const ad::Var<T> u = ad::batched_matvec(k.lower, p, true);  // L^T p
-  // dH/dq at fixed p: V's gradient and the kinetic term's, 1/2 |L^T p|^2 having p u^T in L.
-  const ad::Var<T> kinetic_gradient =
-      layers_cotangent(factor_, hidden, ad::batched_outer(p, u) * k.slope);
-  const ad::Var<T> p_dot =
-      -this->position_gradient(q, this->mlp_.input_gradient(in, 0) + kinetic_gradient);
+  const ad::Var<T> p_dot = momentum_rate(q, in, hidden, k, p, u);
   // v = M^-1 p: dv/dt = M^-1 dp/dt + (dL L^T + L dL^T) p, dL the factor's tangent along q' = v.
   const ad::Var<T> l_dot = layers_tangent(factor_, hidden, this->position_tangent(q, v)) * k.slope;
   const ad::Var<T> v_dot = ad::batched_matvec(k.minv, p_dot) + ad::batched_matvec(l_dot, u) +
                            ad::batched_matvec(k.lower, ad::batched_matvec(l_dot, p, true));
   hidden.clear();  // release the handles (capacity stays)
   return ad::concat_cols<T>({v, v_dot});
+}
+
+template <typename T>
+ad::Var<T> MassHnn<T>::integrated_state(const ad::Var<T>& x) const {
+  this->check_input("integrated_state", x.rows(), x.cols());
+  const Index n = x.cols() / 2;
+  const ad::Var<T> q = ad::slice_cols(x, 0, n);
+  return ad::concat_cols<T>({q, ad::batched_spd_solve(factor_at(q).minv, ad::slice_cols(x, n, n))});
+}
+
+template <typename T>
+ad::Var<T> MassHnn<T>::integrated_derivative(const ad::Var<T>& z) const {
+  this->check_input("integrated_derivative", z.rows(), z.cols());
+  const Index n = z.cols() / 2;
+  const ad::Var<T> q = ad::slice_cols(z, 0, n), p = ad::slice_cols(z, n, n);
+  const ad::Var<T> in = this->position_input(q);
+  thread_local std::vector<ad::Var<T>> hidden;  // reused: no allocation per step
+  const Factor k = factor(layers_forward(factor_, in, hidden));
+  const ad::Var<T> q_dot = ad::batched_matvec(k.minv, p);
+  const ad::Var<T> p_dot = momentum_rate(q, in, hidden, k, p, ad::batched_matvec(k.lower, p, true));
+  hidden.clear();
+  return ad::concat_cols<T>({q_dot, p_dot});
+}
+
+template <typename T>
+ad::Var<T> MassHnn<T>::observed_state(const ad::Var<T>& z) const {
+  this->check_input("observed_state", z.rows(), z.cols());
+  const Index n = z.cols() / 2;
+  const ad::Var<T> q = ad::slice_cols(z, 0, n);
+  return ad::concat_cols<T>({q, ad::batched_matvec(factor_at(q).minv, ad::slice_cols(z, n, n))});
 }
 
 template <typename T>
@@ -169,9 +210,8 @@ Matrix<T> MassHnn<T>::energy(const MatrixView<T>& x) const {
   const Index n = x.cols() / 2;
   const ad::Var<T> state = ad::Var<T>::constant(x);
   const ad::Var<T> q = ad::slice_cols(state, 0, n), v = ad::slice_cols(state, n, n);
-  const ad::Var<T> in = this->position_input(q);
-  const ad::Var<T> p = ad::batched_spd_solve(factor(factor_.forward(in)).minv, v);
-  return (ad::sum_cols(p * v) * T(0.5) + this->mlp_.forward(in)).value();
+  const ad::Var<T> p = ad::batched_spd_solve(factor_at(q).minv, v);
+  return (ad::sum_cols(p * v) * T(0.5) + this->mlp_.forward(this->position_input(q))).value();
 }
 
 template <typename T>
@@ -181,7 +221,7 @@ Matrix<T> MassHnn<T>::inverse_mass(const MatrixView<T>& x) const {
   ad::NoGradGuard values_only;
   const Index n = x.cols() / 2;
   const ad::Var<T> state = ad::Var<T>::constant(x);
-  return factor(factor_.forward(this->position_input(ad::slice_cols(state, 0, n)))).minv.value();
+  return factor_at(ad::slice_cols(state, 0, n)).minv.value();
 }
 
 template <typename T>

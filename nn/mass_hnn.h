@@ -9,8 +9,15 @@
 // where dL is the factor's tangent along the motion: one forward-mode pass of its MLP beside
 // the reverse pass that dH/dq takes. Every piece is an engine op, so training differentiates
 // through the field to any order.
+//
+// Training through fixed steps integrates (q, p) instead, as their HNN.integrate does: p = M v
+// is solved for once per start, each stage is Hamilton's equations (no solve, no tangent pass)
+// and each output reads v = M^-1 p. The two are the same motion but not the same RK4 steps: in
+// (q, v) every stage solves with the stage's M^-1, which early in training may be nearly
+// singular, and amplifies its error (docs/tasks.md, "Where their HNN fails").
 
 #include <random>
+#include <vector>
 
 #include "nn/dynamics.h"
 
@@ -43,6 +50,12 @@ class MassHnn : public DynamicsModel<T> {
   /// (v, dv/dt), on the tape to any order. Throws ad::Error naming the row where a learned
   /// M^-1 is not finite or too ill-conditioned to solve for p.
   ad::Var<T> time_derivative(const ad::Var<T>& x) const override;
+  /// (q, p = M(q) v): what fixed-step integrators carry, as theirs. Throws as time_derivative.
+  ad::Var<T> integrated_state(const ad::Var<T>& x) const override;
+  /// Hamilton's equations in (q, p): dq/dt = M^-1 p, dp/dt = -dH/dq. No solve, no tangent pass.
+  ad::Var<T> integrated_derivative(const ad::Var<T>& z) const override;
+  /// (q, v = M^-1(q) p).
+  ad::Var<T> observed_state(const ad::Var<T>& z) const override;
 
   /// "hnn-mass V 2-256-256-1, L 2-256-256-4 tanh orthogonal", for logs.
   std::string describe() const override;
@@ -55,8 +68,14 @@ class MassHnn : public DynamicsModel<T> {
   }
 
  private:
-  struct Factor;                               // L and M^-1 of one batch
-  Factor factor(const ad::Var<T>& raw) const;  // from the factor MLP's output
+  struct Factor;                                // L and M^-1 of one batch
+  Factor factor(const ad::Var<T>& raw) const;   // from the factor MLP's output
+  Factor factor_at(const ad::Var<T>& q) const;  // L and M^-1 of positions q
+  // dp/dt = -dH/dq at fixed momenta p, from the factor's pass at q (its MLP input `in`, its
+  // hidden activations) and u = L^T p.
+  ad::Var<T> momentum_rate(const ad::Var<T>& q, const ad::Var<T>& in,
+                           const std::vector<ad::Var<T>>& hidden, const Factor& k,
+                           const ad::Var<T>& p, const ad::Var<T>& u) const;
   void form_constants();
 
   Mlp<T> factor_;

@@ -231,11 +231,11 @@ class Model {
   ad::Var<T> rollout_loss(const Rows& rows, std::size_t parts,
                           const nn::DynamicsModel<T>& model) const {
     const std::size_t horizon = (parts - 1) / 2;
-    ad::Var<T> x = rows(0), total;
+    ad::Var<T> z = model.integrated_state(rows(0)), total;
     for (std::size_t j = 0; j < horizon; ++j) {
       const ad::Var<T> h = rows(1 + horizon + j);
-      x = hnn::tasks::integrator_step(model, x, h, integrator_);
-      const ad::Var<T> target = rows(1 + j);
+      z = hnn::tasks::integrator_step(model, z, h, integrator_);
+      const ad::Var<T> x = model.observed_state(z), target = rows(1 + j);
       const ad::Var<T> step_loss =
           l1_ ? hnn::tasks::mean_absolute_error(x, target) : nn::mse(x, target);
       total = total.defined() ? total + step_loss : step_loss;

@@ -45,12 +45,12 @@ Predictor model_predictor(const nn::DynamicsModel<double>& model, const StretchS
     ad::TapeScope scope;
     ad::NoGradGuard values_only;
     std::vector<Batch> states{x0};
-    ad::Var<double> x = ad::Var<double>::constant(x0);
+    ad::Var<double> z = model.integrated_state(ad::Var<double>::constant(x0));
     for (Eigen::Index k = 1; k < t.size(); ++k) {
       const ad::Var<double> h =
           ad::Var<double>::constant(Batch::Constant(x0.rows(), 1, (t(k) - t(k - 1)) / substeps));
-      for (int s = 0; s < substeps; ++s) x = integrator_step(model, x, h, integrator);
-      states.push_back(x.value());
+      for (int s = 0; s < substeps; ++s) z = integrator_step(model, z, h, integrator);
+      states.push_back(model.observed_state(z).value());
     }
     return states;
   };

@@ -49,19 +49,20 @@ Var<T> leapfrog(const nn::DynamicsModel<T>& model, const Var<T>& x, const Var<T>
   const Var<T> half = h * T(0.5);
   const Var<T> q = ad::slice_cols(x, 0, n);
   const Var<T> p_half =
-      ad::slice_cols(x, n, n) + half * ad::slice_cols(model.time_derivative(x), n, n);
-  const Var<T> q1 = q + h * ad::slice_cols(model.time_derivative(join(q, p_half)), 0, n);
-  const Var<T> p1 = p_half + half * ad::slice_cols(model.time_derivative(join(q1, p_half)), n, n);
+      ad::slice_cols(x, n, n) + half * ad::slice_cols(model.integrated_derivative(x), n, n);
+  const Var<T> q1 = q + h * ad::slice_cols(model.integrated_derivative(join(q, p_half)), 0, n);
+  const Var<T> p1 =
+      p_half + half * ad::slice_cols(model.integrated_derivative(join(q1, p_half)), n, n);
   return join(q1, p1);
 }
 
 template <typename T>
 Var<T> rk4(const nn::DynamicsModel<T>& model, const Var<T>& x, const Var<T>& h) {
   const Var<T> half = h * T(0.5);
-  const Var<T> k1 = model.time_derivative(x);
-  const Var<T> k2 = model.time_derivative(x + half * k1);
-  const Var<T> k3 = model.time_derivative(x + half * k2);
-  const Var<T> k4 = model.time_derivative(x + h * k3);
+  const Var<T> k1 = model.integrated_derivative(x);
+  const Var<T> k2 = model.integrated_derivative(x + half * k1);
+  const Var<T> k3 = model.integrated_derivative(x + half * k2);
+  const Var<T> k4 = model.integrated_derivative(x + h * k3);
   return x + (h * T(1.0 / 6.0)) * (k1 + T(2) * k2 + T(2) * k3 + k4);
 }
 
@@ -71,11 +72,19 @@ Var<T> rk4(const nn::DynamicsModel<T>& model, const Var<T>& x, const Var<T>& h) 
 template <typename T>
 Var<T> rk4_38(const nn::DynamicsModel<T>& model, const Var<T>& x, const Var<T>& h) {
   const Var<T> third = h * T(1.0 / 3.0);
-  const Var<T> k1 = model.time_derivative(x);
-  const Var<T> k2 = model.time_derivative(x + third * k1);
-  const Var<T> k3 = model.time_derivative(x + h * k2 - third * k1);
-  const Var<T> k4 = model.time_derivative(x + h * (k1 - k2 + k3));
+  const Var<T> k1 = model.integrated_derivative(x);
+  const Var<T> k2 = model.integrated_derivative(x + third * k1);
+  const Var<T> k3 = model.integrated_derivative(x + h * k2 - third * k1);
+  const Var<T> k4 = model.integrated_derivative(x + h * (k1 - k2 + k3));
   return x + (h * T(1.0 / 8.0)) * (k1 + T(3) * (k2 + k3) + k4);
+}
+
+// The carried field's values, off the tape (midpoint_solve's iterations).
+template <typename T>
+Matrix<T> integrated_field(const nn::DynamicsModel<T>& model, const Matrix<T>& z) {
+  ad::TapeScope scope;
+  ad::NoGradGuard values_only;
+  return model.integrated_derivative(Var<T>::constant(z)).value();
 }
 
 template <typename T>
@@ -155,7 +164,7 @@ Var<T> midpoint(const nn::DynamicsModel<T>& model, const Var<T>& x, const Var<T>
   if (!ad::grad_enabled()) return Var<T>::constant(x1);
   const Var<T> x1c = Var<T>::constant(x1);
   const Var<T> m = (x + x1c) * T(0.5);
-  const Var<T> residual = x1c - x - h * model.time_derivative(m);
+  const Var<T> residual = x1c - x - h * model.integrated_derivative(m);
   const Matrix<T> a = newton_matrix<T>(field_row_jacobian(model, m.value()), h.value(), x.cols());
   return x1c - ad::batched_solve(Var<T>::constant(a), residual);
 }
@@ -182,7 +191,7 @@ Matrix<T> field_row_jacobian(const nn::DynamicsModel<T>& model, const Matrix<T>&
   ad::GradModeGuard recording(true);
   const Var<T> xv = Var<T>::leaf(x);
   // Rows are independent samples: row r of f depends on row r of x only.
-  return ad::row_jacobian(model.time_derivative(xv), xv, {.allow_unused = true}).value();
+  return ad::row_jacobian(model.integrated_derivative(xv), xv, {.allow_unused = true}).value();
 }
 
 template <typename T>
@@ -192,7 +201,7 @@ Matrix<T> midpoint_solve(const nn::DynamicsModel<T>& model, const Matrix<T>& x0,
   const auto step = [&](const Matrix<T>& f) -> Matrix<T> {
     return x0 + (f.array().colwise() * h.col(0).array()).matrix();
   };
-  Matrix<T> x1 = step(model.field(x0));  // explicit Euler: the first guess
+  Matrix<T> x1 = step(integrated_field(model, x0));  // explicit Euler: the first guess
   Matrix<T> accepted = x1;  // per row, the last iterate that did not raise its residual
   Eigen::VectorXd accepted_norm = Eigen::VectorXd::Constant(x0.rows(), INFINITY);
   Eigen::Matrix<T, Eigen::Dynamic, 1> damping =
@@ -203,7 +212,7 @@ Matrix<T> midpoint_solve(const nn::DynamicsModel<T>& model, const Matrix<T>& x0,
   std::pair<double, Eigen::Index> worst{0, 0};
   for (int it = 0; it <= solve.max_iterations; ++it) {
     const Matrix<T> m = (x0 + x1) * T(0.5);
-    const Matrix<T> next = step(model.field(m));
+    const Matrix<T> next = step(integrated_field(model, m));
     const Matrix<T> residual = x1 - next;
     worst = worst_residual<T>(residual, x1);
     if (worst.first <= double(tolerance)) return x1;

@@ -1,8 +1,10 @@
 #pragma once
 // One step of an integrator through a model's field x' = f(x), recorded on the tape so that a
 // loss on the states it reaches differentiates through it (and, for an HNN, through the field:
-// a second-order path). The state is x = (q, p), q the first half of the columns; a model only
-// supplies time_derivative(x), so every method works for hnn, baseline and dhnn alike.
+// a second-order path). The state is the model's carried one (DynamicsModel::integrated_state:
+// the observed x for every model but the mass HNN, which carries (q, p)), q the first half of the
+// columns; a model only supplies integrated_derivative, so every method works for hnn, baseline
+// and dhnn alike.
 //
 // - rk4: the classical Runge-Kutta method, order 4, not symplectic.
 // - leapfrog: kick-drift-kick on the field's p-part and q-part,

@@ -210,12 +210,12 @@ ad::Var<T> RolloutObjective<T>::rows_loss(const nn::DynamicsModel<T>& model,
   const auto rows = [&](std::size_t slot) {
     return ad::Var<T>::constant(scratch_[slot].middleRows(block.begin, block.size()));
   };
-  ad::Var<T> x = rows(0);
+  ad::Var<T> z = model.integrated_state(rows(0));
   ad::Var<T> total;
   for (std::size_t j = 0; j < horizon_; ++j) {
     const ad::Var<T> h = rows(1 + 2 * j);
-    for (int s = 0; s < substeps_; ++s) x = integrator_step(model, x, h, integrator_);
-    const ad::Var<T> target = rows(2 + 2 * j);
+    for (int s = 0; s < substeps_; ++s) z = integrator_step(model, z, h, integrator_);
+    const ad::Var<T> x = model.observed_state(z), target = rows(2 + 2 * j);
     const ad::Var<T> step_loss =
         norm_ == RolloutNorm::kL1 ? mean_absolute_error(x, target) : nn::mse(x, target);
     total = total.defined() ? total + step_loss : step_loss;

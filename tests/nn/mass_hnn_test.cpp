@@ -1,7 +1,8 @@
 // The mass HNN (Finzi et al.'s HNN, nn/mass_hnn.h): its field in (q, v) is Hamilton's equations
 // of its own H(q, p) = 1/2 p^T M^-1(q) p + V(q) with p = M(q) v, checked against central
 // differences of H and of v = M^-1 p; it conserves its learned energy; its M^-1 is positive
-// definite; its training gradient matches finite differences to second order, with angles;
+// definite; the (q, p) it carries through integrators is the same motion; its training
+// gradients, in (q, v) and through a carried step, match finite differences to second order;
 // float and double casts agree; a clear error for what it cannot be.
 
 #include <gtest/gtest.h>
@@ -121,6 +122,41 @@ TEST(MassHnn, TrainingGradientsMatchFiniteDifferencesToSecondOrder) {
   const nn::MassHnn<double> model = small_mass_hnn(4, 2, 70, {5, 4});
   const auto checks =
       nn::testing::check_training_gradients(model, random_qv(3, 4, 71), random_qv(3, 4, 72));
+  EXPECT_TRUE(checks.first.ok) << checks.first.worst << "\n" << checks.first.log;
+  EXPECT_TRUE(checks.second.ok) << checks.second.worst << "\n" << checks.second.log;
+}
+
+// Fixed-step integrators carry (q, p) (nn/mass_hnn.h): the map there and back is the identity,
+// its p is M(q) v, and the carried field, seen through observed_state, is time_derivative's
+// motion in (q, v).
+TEST(MassHnn, CarriesCanonicalStatesForIntegrators) {
+  const nn::MassHnn<double> model = small_mass_hnn(6, 3, 100);
+  const MatrixD x = random_qv(5, 6, 101, 2.0);
+  const auto state = [&](const MatrixD& z) {
+    return model.observed_state(Var<double>::constant(z)).value();
+  };
+  const MatrixD z = model.integrated_state(Var<double>::constant(x)).value();
+  EXPECT_EQ(z.leftCols(3), x.leftCols(3));
+  EXPECT_LT((z.rightCols(3) - momenta(model, x)).cwiseAbs().maxCoeff(), 1e-12);
+  EXPECT_LT((state(z) - x).cwiseAbs().maxCoeff(), 1e-12);
+  const MatrixD g = model.integrated_derivative(Var<double>::constant(z)).value();
+  const MatrixD along = (state(z + kStep * g) - state(z - kStep * g)) / (2 * kStep);
+  const MatrixD f = model.field(x);
+  EXPECT_LT((along - f).cwiseAbs().maxCoeff(), 1e-7 * (1 + f.cwiseAbs().maxCoeff()))
+      << "d/dt observed_state along the carried field\n"
+      << along << "\ntime_derivative\n"
+      << f;
+}
+
+TEST(MassHnn, CarriedStepGradientsMatchFiniteDifferencesToSecondOrder) {
+  const nn::MassHnn<double> model = small_mass_hnn(4, 2, 110, {5, 4});
+  // One explicit Euler step in (q, p), read back in (q, v): every carried piece on one path.
+  const auto step = [&](const Var<double>& x) {
+    const Var<double> z = model.integrated_state(x);
+    return model.observed_state(z + model.integrated_derivative(z) * 0.1);
+  };
+  const auto checks = nn::testing::check_training_gradients(model, random_qv(3, 4, 111),
+                                                            random_qv(3, 4, 112), step);
   EXPECT_TRUE(checks.first.ok) << checks.first.worst << "\n" << checks.first.log;
   EXPECT_TRUE(checks.second.ok) << checks.second.worst << "\n" << checks.second.log;
 }

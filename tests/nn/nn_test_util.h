@@ -2,6 +2,7 @@
 // Shared helpers of the nn tests: the ideal mass-spring data set and a plain training loop.
 
 #include <cmath>
+#include <functional>
 #include <random>
 #include <vector>
 
@@ -72,18 +73,22 @@ inline DynamicsConfig small_config(ModelKind kind, Index dim, std::vector<Index>
   return config;
 }
 
-/// The training loss mse(model.time_derivative(x), target) differentiated in x and in every
-/// parameter, against central differences: first (gradcheck) and second order (gradgradcheck).
+/// The training loss mse(field(x), target) differentiated in x and in every parameter, against
+/// central differences: first (gradcheck) and second order (gradgradcheck). `field` is the
+/// model's time_derivative unless given.
 struct TrainingGradientChecks {
   ad::CheckResult first, second;
 };
+using FieldOnTape = std::function<ad::Var<double>(const ad::Var<double>&)>;
 inline TrainingGradientChecks check_training_gradients(const DynamicsModel<double>& model,
                                                        const Matrix<double>& x,
-                                                       const Matrix<double>& target) {
+                                                       const Matrix<double>& target,
+                                                       FieldOnTape field = {}) {
+  if (!field) field = [&](const ad::Var<double>& in) { return model.time_derivative(in); };
   auto& bound = const_cast<DynamicsModel<double>&>(model);  // rebound to the checks' leaves
   const auto loss = [&](const std::vector<ad::Var<double>>& in) {
     bound.bind_parameters(std::vector<ad::Var<double>>(in.begin() + 1, in.end()));
-    return mse(model.time_derivative(in[0]), ad::Var<double>::constant(target));
+    return mse(field(in[0]), ad::Var<double>::constant(target));
   };
   std::vector<Matrix<double>> inputs{x};
   for (const ad::Var<double>& p : model.parameters()) inputs.push_back(p.value());
