@@ -140,6 +140,9 @@ class DynamicsModel : public Module<T> {
   virtual ad::Var<T> integrated_state(const ad::Var<T>& x) const { return x; }
   virtual ad::Var<T> integrated_derivative(const ad::Var<T>& z) const { return time_derivative(z); }
   virtual ad::Var<T> observed_state(const ad::Var<T>& z) const { return z; }
+  /// integrated_derivative as plain values (the implicit midpoint's iterations): field(z) for
+  /// every model but the mass HNN.
+  virtual Matrix<T> integrated_field(const MatrixView<T>& z) const { return field(z); }
 
   const DynamicsConfig& config() const { return config_; }
   Index dim() const { return config_.dim; }

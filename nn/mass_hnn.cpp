@@ -83,6 +83,14 @@ ad::Var<T> layers_cotangent(const Mlp<T>& mlp, const std::vector<ad::Var<T>>& hi
   return g;
 }
 
+// (q, f(q, w)) of rows (q, w): the positions kept, the second half mapped (v to p and back).
+template <typename T, typename F>
+ad::Var<T> map_second_half(const ad::Var<T>& x, const F& f) {
+  const Index n = x.cols() / 2;
+  const ad::Var<T> q = ad::slice_cols(x, 0, n);
+  return ad::concat_cols<T>({q, f(q, ad::slice_cols(x, n, n))});
+}
+
 }  // namespace
 
 MlpConfig factor_mlp_config(const DynamicsConfig& config) {
@@ -175,9 +183,9 @@ ad::Var<T> MassHnn<T>::time_derivative(const ad::Var<T>& x) const {
 template <typename T>
 ad::Var<T> MassHnn<T>::integrated_state(const ad::Var<T>& x) const {
   this->check_input("integrated_state", x.rows(), x.cols());
-  const Index n = x.cols() / 2;
-  const ad::Var<T> q = ad::slice_cols(x, 0, n);
-  return ad::concat_cols<T>({q, ad::batched_spd_solve(factor_at(q).minv, ad::slice_cols(x, n, n))});
+  return map_second_half(x, [&](const ad::Var<T>& q, const ad::Var<T>& v) {
+    return ad::batched_spd_solve(factor_at(q).minv, v);
+  });
 }
 
 template <typename T>
@@ -197,9 +205,17 @@ ad::Var<T> MassHnn<T>::integrated_derivative(const ad::Var<T>& z) const {
 template <typename T>
 ad::Var<T> MassHnn<T>::observed_state(const ad::Var<T>& z) const {
   this->check_input("observed_state", z.rows(), z.cols());
-  const Index n = z.cols() / 2;
-  const ad::Var<T> q = ad::slice_cols(z, 0, n);
-  return ad::concat_cols<T>({q, ad::batched_matvec(factor_at(q).minv, ad::slice_cols(z, n, n))});
+  return map_second_half(z, [&](const ad::Var<T>& q, const ad::Var<T>& p) {
+    return ad::batched_matvec(factor_at(q).minv, p);
+  });
+}
+
+template <typename T>
+Matrix<T> MassHnn<T>::integrated_field(const MatrixView<T>& z) const {
+  this->check_input("integrated_field", z.rows(), z.cols());
+  ad::TapeScope scope;
+  ad::NoGradGuard values_only;
+  return integrated_derivative(ad::Var<T>::constant(z)).value();
 }
 
 template <typename T>

@@ -56,6 +56,8 @@ class MassHnn : public DynamicsModel<T> {
   ad::Var<T> integrated_derivative(const ad::Var<T>& z) const override;
   /// (q, v = M^-1(q) p).
   ad::Var<T> observed_state(const ad::Var<T>& z) const override;
+  /// integrated_derivative's values.
+  Matrix<T> integrated_field(const MatrixView<T>& z) const override;
 
   /// "hnn-mass V 2-256-256-1, L 2-256-256-4 tanh orthogonal", for logs.
   std::string describe() const override;

@@ -22,7 +22,6 @@ loss after --steps steps.
 """
 import argparse
 import csv
-import math
 
 import torch
 import torch.nn as nn

@@ -79,14 +79,6 @@ Var<T> rk4_38(const nn::DynamicsModel<T>& model, const Var<T>& x, const Var<T>& 
   return x + (h * T(1.0 / 8.0)) * (k1 + T(3) * (k2 + k3) + k4);
 }
 
-// The carried field's values, off the tape (midpoint_solve's iterations).
-template <typename T>
-Matrix<T> integrated_field(const nn::DynamicsModel<T>& model, const Matrix<T>& z) {
-  ad::TapeScope scope;
-  ad::NoGradGuard values_only;
-  return model.integrated_derivative(Var<T>::constant(z)).value();
-}
-
 template <typename T>
 T default_tolerance() {
   return std::is_same_v<T, float> ? T(1e-5) : T(1e-12);
@@ -201,7 +193,7 @@ Matrix<T> midpoint_solve(const nn::DynamicsModel<T>& model, const Matrix<T>& x0,
   const auto step = [&](const Matrix<T>& f) -> Matrix<T> {
     return x0 + (f.array().colwise() * h.col(0).array()).matrix();
   };
-  Matrix<T> x1 = step(integrated_field(model, x0));  // explicit Euler: the first guess
+  Matrix<T> x1 = step(model.integrated_field(x0));  // explicit Euler: the first guess
   Matrix<T> accepted = x1;  // per row, the last iterate that did not raise its residual
   Eigen::VectorXd accepted_norm = Eigen::VectorXd::Constant(x0.rows(), INFINITY);
   Eigen::Matrix<T, Eigen::Dynamic, 1> damping =
@@ -212,7 +204,7 @@ Matrix<T> midpoint_solve(const nn::DynamicsModel<T>& model, const Matrix<T>& x0,
   std::pair<double, Eigen::Index> worst{0, 0};
   for (int it = 0; it <= solve.max_iterations; ++it) {
     const Matrix<T> m = (x0 + x1) * T(0.5);
-    const Matrix<T> next = step(integrated_field(model, m));
+    const Matrix<T> next = step(model.integrated_field(m));
     const Matrix<T> residual = x1 - next;
     worst = worst_residual<T>(residual, x1);
     if (worst.first <= double(tolerance)) return x1;
