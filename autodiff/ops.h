@@ -123,9 +123,11 @@ Var<T> batched_outer(const Var<T>& u, const Var<T>& v);
 /// derivative exact for any input: d/db = gb = batched_spd_solve(a, g); d/da = -(batched_outer(gb,
 /// x) + batched_outer(x, gb)) / 2. Throws hnn::ad::Error naming the row of a block that is not
 /// finite, not positive definite, or whose 1-norm rcond is below kBatchedSolveMinRcond (computed
-/// exactly from the inverse), or of a non-finite right-hand side.
+/// exactly from the inverse; `min_rcond` lowers it for a caller whose solution's error the
+/// result does not carry, see MassHnn), or of a non-finite right-hand side.
 template <typename T>
-Var<T> batched_spd_solve(const Var<T>& a, const Var<T>& b);
+Var<T> batched_spd_solve(const Var<T>& a, const Var<T>& b,
+                         double min_rcond = double(kBatchedSolveMinRcond<T>));
 /// The same solve for another right-hand side, reusing the factors of `factored`, an earlier
 /// batched_spd_solve(a, .) of this very `a` (checked: it throws otherwise). Constrained
 /// mechanics solves S twice per field, and every solve's backward solves it once more.

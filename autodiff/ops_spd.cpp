@@ -96,7 +96,7 @@ double reciprocal_condition(const T* a, const T* l, Eigen::Index n, T* column) {
 // nothing).
 template <typename T>
 SpdFailure factor_and_solve_block(const Matrix<T>& a, const Matrix<T>& b, Node<T>& node, RowBlock r,
-                                  Matrix<T>& column) {
+                                  Matrix<T>& column, double min_rcond) {
   const Eigen::Index n = b.cols();
   Matrix<T>& factors = node.buffers[kFactors];
   for (Eigen::Index row = r.begin; row < r.end; ++row) {
@@ -105,9 +105,7 @@ SpdFailure factor_and_solve_block(const Matrix<T>& a, const Matrix<T>& b, Node<T
     T* l = factors.row(row).data();
     if (!factor_row(a.row(row).data(), n, l)) return {SpdFailure::kNotPositiveDefinite, row};
     const double rcond = reciprocal_condition(a.row(row).data(), l, n, column.data());
-    if (!(rcond >= double(kBatchedSolveMinRcond<T>))) {
-      return {SpdFailure::kIllConditioned, row, rcond};
-    }
+    if (!(rcond >= min_rcond)) return {SpdFailure::kIllConditioned, row, rcond};
     solve_row<T>(l, n, b.row(row).data(), node.value.row(row).data());
   }
   return {};
@@ -151,7 +149,7 @@ void remember_factors(Node<T>& node, const Var<T>& a, const Matrix<T>& factors) 
 
 // Factors every row of sym(A) into the node, checks it, and solves.
 template <typename T>
-SpdFailure factor_and_solve(const Var<T>& a, const Matrix<T>& b, Node<T>& node) {
+SpdFailure factor_and_solve(const Var<T>& a, const Matrix<T>& b, Node<T>& node, double min_rcond) {
   const Eigen::Index n = b.cols(), rows = b.rows();
   node.buffers.resize(std::size_t(1 + parts_for(rows)));
   node.buffers[kFactors].resize(rows, n * n);
@@ -160,7 +158,7 @@ SpdFailure factor_and_solve(const Var<T>& a, const Matrix<T>& b, Node<T>& node) 
   return over_row_blocks(rows, [&](int p, RowBlock r) {
     Matrix<T>& column = node.buffers[std::size_t(1 + p)];
     column.resize(1, n);
-    return factor_and_solve_block<T>(a.value(), b, node, r, column);
+    return factor_and_solve_block<T>(a.value(), b, node, r, column, min_rcond);
   });
 }
 
@@ -176,7 +174,8 @@ SpdFailure solve_factored(const Matrix<T>& factors, const Var<T>& a, const Matri
 }
 
 template <typename T>
-void throw_spd_failure(const SpdFailure& bad, Eigen::Index rows) {
+void throw_spd_failure(const SpdFailure& bad, Eigen::Index rows,
+                       double min_rcond = double(kBatchedSolveMinRcond<T>)) {
   switch (bad.kind) {
     case SpdFailure::kNone:
       return;
@@ -195,7 +194,7 @@ void throw_spd_failure(const SpdFailure& bad, Eigen::Index rows) {
       throw Error(fmt::format(
           "batched_spd_solve: block {} of {} is ill-conditioned (rcond {:.3g}, below the minimum "
           "{:.3g} for this precision)",
-          bad.row, rows, bad.rcond, double(kBatchedSolveMinRcond<T>)));
+          bad.row, rows, bad.rcond, min_rcond));
   }
 }
 
@@ -222,10 +221,10 @@ void check_shapes(const Var<T>& a, const Var<T>& b) {
 }  // namespace
 
 template <typename T>
-Var<T> batched_spd_solve(const Var<T>& a, const Var<T>& b) {
+Var<T> batched_spd_solve(const Var<T>& a, const Var<T>& b, double min_rcond) {
   check_shapes(a, b);
   Node<T>& node = detail::record<T>("batched_spd_solve", {a, b}, spd_solve_backward<T>);
-  throw_spd_failure<T>(factor_and_solve<T>(a, b.value(), node), a.rows());
+  throw_spd_failure<T>(factor_and_solve<T>(a, b.value(), node, min_rcond), a.rows(), min_rcond);
   return Var<T>::of(node);
 }
 
@@ -245,8 +244,8 @@ Var<T> batched_spd_solve_factored(const Var<T>& a, const Var<T>& b, const Var<T>
   return Var<T>::of(node);
 }
 
-#define HNN_INSTANTIATE(T)                                         \
-  template Var<T> batched_spd_solve(const Var<T>&, const Var<T>&); \
+#define HNN_INSTANTIATE(T)                                                 \
+  template Var<T> batched_spd_solve(const Var<T>&, const Var<T>&, double); \
   template Var<T> batched_spd_solve_factored(const Var<T>&, const Var<T>&, const Var<T>&);
 HNN_INSTANTIATE(float)
 HNN_INSTANTIATE(double)

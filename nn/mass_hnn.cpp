@@ -169,7 +169,7 @@ ad::Var<T> MassHnn<T>::time_derivative(const ad::Var<T>& x) const {
   const ad::Var<T> in = this->position_input(q);
   thread_local std::vector<ad::Var<T>> hidden;  // reused: no allocation per step
   const Factor k = factor(layers_forward(factor_, in, hidden));
-  const ad::Var<T> p = ad::batched_spd_solve(k.minv, v);
+  const ad::Var<T> p = ad::batched_spd_solve(k.minv, v, kMassHnnMinRcond<T>);
   const ad::Var<T> u = ad::batched_matvec(k.lower, p, true);  // L^T p
   const ad::Var<T> p_dot = momentum_rate(q, in, hidden, k, p, u);
   // v = M^-1 p: dv/dt = M^-1 dp/dt + (dL L^T + L dL^T) p, dL the factor's tangent along q' = v.
@@ -184,7 +184,7 @@ template <typename T>
 ad::Var<T> MassHnn<T>::integrated_state(const ad::Var<T>& x) const {
   this->check_input("integrated_state", x.rows(), x.cols());
   return map_second_half(x, [&](const ad::Var<T>& q, const ad::Var<T>& v) {
-    return ad::batched_spd_solve(factor_at(q).minv, v);
+    return ad::batched_spd_solve(factor_at(q).minv, v, kMassHnnMinRcond<T>);
   });
 }
 
@@ -226,7 +226,7 @@ Matrix<T> MassHnn<T>::energy(const MatrixView<T>& x) const {
   const Index n = x.cols() / 2;
   const ad::Var<T> state = ad::Var<T>::constant(x);
   const ad::Var<T> q = ad::slice_cols(state, 0, n), v = ad::slice_cols(state, n, n);
-  const ad::Var<T> p = ad::batched_spd_solve(factor_at(q).minv, v);
+  const ad::Var<T> p = ad::batched_spd_solve(factor_at(q).minv, v, kMassHnnMinRcond<T>);
   return (ad::sum_cols(p * v) * T(0.5) + this->mlp_.forward(this->position_input(q))).value();
 }
 

@@ -16,6 +16,7 @@
 // (q, v) every stage solves with the stage's M^-1, which early in training may be nearly
 // singular, and amplifies its error (docs/tasks.md, "Where their HNN fails").
 
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -26,6 +27,14 @@ namespace hnn::nn {
 /// The diagonal eps of M^-1 = L L^T + eps I: theirs, which keeps M^-1 invertible however small
 /// the learned factor.
 inline constexpr double kMassHnnEpsilon = 1e-4;
+
+/// The least rcond of M^-1 at which p = M v is solved: one epsilon, below which no digit of p is
+/// left, instead of the engine's 100 (ad::kBatchedSolveMinRcond). Above it p is off by about
+/// eps / rcond (6% at the rotor's 1.9e-6 in float), an error the loss of that start's chunk sees
+/// and training moves away from; their float32 code solves at any conditioning, so a run stopped
+/// there would be one theirs trains on. (The rotor's seed 2 stopped at step 1,262 on it.)
+template <typename T>
+inline constexpr double kMassHnnMinRcond = double(std::numeric_limits<T>::epsilon());
 
 /// config.model kMassHnn, activation tanh. Parameters: "mlp.layers.<i>.weight|bias" of V's MLP,
 /// "mass.layers.<i>.weight|bias" of L's.

@@ -19,9 +19,15 @@ using ad::testing::MatrixD;
 
 namespace {
 
+// batched_spd_solve at its default least rcond.
+template <typename T>
+Var<T> SpdSolve(const Var<T>& a, const Var<T>& b) {
+  return ad::batched_spd_solve(a, b);
+}
+
 // Heap allocations of `steps` steps after `warmup`: x = solve(A, b), loss = sum(x^2), its
 // gradient with create_graph, and the gradient of |grad|^2 (the backward's own backward).
-template <typename T, typename Solve = decltype(&ad::batched_spd_solve<T>)>
+template <typename T, typename Solve = Var<T> (*)(const Var<T>&, const Var<T>&)>
 long AllocationsOfSolveSteps(
     Eigen::Index rows, Eigen::Index n, int warmup, int steps,
     Solve solve = [](const Var<T>& a, const Var<T>& b) { return ad::batched_solve(a, b); }) {
@@ -61,9 +67,9 @@ TEST(BatchedAllocations, SpdSolveAndItsDerivativesAllocateNothingAfterWarmUpAtAn
   GTEST_SKIP() << "malloc belongs to the sanitizer in this build";
 #else
   for (Eigen::Index n : {2, 5}) {  // above 4, where batched_solve's LU allocates
-    EXPECT_EQ(AllocationsOfSolveSteps<double>(256, n, 3, 10, &ad::batched_spd_solve<double>), 0)
+    EXPECT_EQ(AllocationsOfSolveSteps<double>(256, n, 3, 10, SpdSolve<double>), 0)
         << "double, n " << n;
-    EXPECT_EQ(AllocationsOfSolveSteps<float>(256, n, 3, 10, &ad::batched_spd_solve<float>), 0)
+    EXPECT_EQ(AllocationsOfSolveSteps<float>(256, n, 3, 10, SpdSolve<float>), 0)
         << "float, n " << n;
   }
 #endif

@@ -114,6 +114,39 @@ TEST(BatchedSpdSolve, NamesTheRowOfABlockItCannotSolve) {
             std::string::npos);
 }
 
+// A float block at rcond 1e-6 lies below the engine's 100 epsilons (1.2e-5) but above one
+// (1.2e-7): refused by default, solved when the caller lowers the minimum to an epsilon (as the
+// mass HNN's momentum solve does), and refused again, naming that minimum, below it.
+TEST(BatchedSpdSolve, ACallerMayLowerTheLeastConditionItSolvesAt) {
+  const double eps = std::numeric_limits<float>::epsilon();
+  ad::Matrix<float> a(1, 4), b(1, 2);
+  a << 1, 0, 0, 1e-6f;
+  b << 2, 3e-6f;
+  const auto solve = [&](double min_rcond) {
+    ad::TapeScope scope;
+    return ad::batched_spd_solve(Var<float>::constant(a), Var<float>::constant(b), min_rcond)
+        .value();
+  };
+  const auto error_of = [&](double min_rcond) -> std::string {
+    try {
+      solve(min_rcond);
+    } catch (const ad::Error& e) {
+      return e.what();
+    }
+    return "";
+  };
+  EXPECT_NE(error_of(100 * eps).find("block 0 of 1 is ill-conditioned (rcond 1e-06, below the "
+                                     "minimum 1.19e-05"),
+            std::string::npos)
+      << error_of(100 * eps);
+  const ad::Matrix<float> x = solve(eps);
+  EXPECT_NEAR(x(0, 0), 2.0, 1e-6);
+  EXPECT_NEAR(x(0, 1), 3.0, 3.0 * eps / 1e-6);
+  a(0, 3) = 1e-8f;
+  EXPECT_NE(error_of(eps).find("(rcond 1e-08, below the minimum 1.19e-07"), std::string::npos)
+      << error_of(eps);
+}
+
 TEST(BatchedSpdSolve, GivesTheSameBitsOnOneThreadAndTwo) {
   const MatrixD a = SpdBlocks(300, 3, 11), b = random_matrix(300, 3, 12);
   const auto solve = [&](int threads) {
