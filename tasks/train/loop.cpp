@@ -133,6 +133,17 @@ double train_step(long step, Objective<T>& objective, nn::RowSplit<T>* split, nn
         fmt::format("training diverged at step {}: the loss is {}{}", step, value, where), step);
   }
   if (loss.defined()) ad::grad_into(loss, adam.parameters(), grads);
+  // A finite loss can still have a non-finite gradient (a solve near singular, a saturated
+  // activation times an overflow): stepping on it would turn every weight into NaN and stop the
+  // run later, at whatever evaluates the model next, under another name.
+  for (const ad::Var<T>& g : grads) {
+    if (g.defined() && !g.value().allFinite()) {
+      throw TrainingDiverged(fmt::format("training diverged at step {}: the loss is {} but its "
+                                         "gradient is not finite{}",
+                                         step, value, where),
+                             step);
+    }
+  }
   adam.step(grads);
   return value;
 }

@@ -9,6 +9,7 @@
 #include <limits>
 #include <map>
 
+#include "autodiff/ops.h"
 #include "nn/hnn.h"
 #include "nn/parameter_file.h"
 #include "reliability_util.h"
@@ -17,6 +18,7 @@
 #include "tasks/field/field_model_run.h"
 #include "tasks/field/field_task.h"
 #include "tasks/train/checkpoint.h"
+#include "tasks/train/field_objective.h"
 #include "tasks/train/loop.h"
 
 namespace hnn::reliability {
@@ -298,6 +300,57 @@ TEST(Divergence, BetweenCheckpointsKeepsTheEarlierOneIntact) {
   nn::Adam<double> adam(loaded.model->parameters());
   tasks::load_train_checkpoint<double>(ckpt, state, *loaded.model, adam);
   for (const auto& p : loaded.model->parameters()) EXPECT_TRUE(p.value().allFinite());
+}
+
+// The spring's field objective, whose loss gains sqrt(0 |w|^2) from step `from` on: the term's
+// value 0 leaves the loss finite, its gradient 0 / (2 sqrt 0) is NaN.
+class NanGradientFrom : public tasks::Objective<double> {
+ public:
+  NanGradientFrom(nn::DynamicsModel<double>& model, const tasks::Dataset& data,
+                  const tasks::TrainConfig& config, long from)
+      : inner_(model, data, config.batch_size, tasks::adam_options(config), 4), from_(from) {}
+  nn::Module<double>& model() override { return inner_.model(); }
+  std::vector<nn::AdamGroup<double>> parameter_groups() const override {
+    return inner_.parameter_groups();
+  }
+  tasks::RowSampler& sampler() override { return inner_.sampler(); }
+  ad::Var<double> batch_loss() override {
+    const ad::Var<double> loss = inner_.batch_loss();
+    if (++steps_ < from_) return loss;
+    return loss + ad::sqrt(ad::sum(ad::square(inner_.model().parameters()[0])) * 0.0);
+  }
+  tasks::CurvePoint curve_point(long step, double batch_loss) const override {
+    return inner_.curve_point(step, batch_loss);
+  }
+  std::uint64_t data_fingerprint() const override { return inner_.data_fingerprint(); }
+
+ private:
+  tasks::FieldObjective<double> inner_;
+  long from_, steps_ = 0;
+};
+
+// A finite loss whose gradient is not finite stops the run at that step, saying so, before the
+// update: the parameters and the last checkpoint stay finite.
+TEST(Divergence, ANonFiniteGradientOfAFiniteLossStopsBeforeTheUpdate) {
+  const TempDir dir;
+  const fs::path ckpt = dir / "checkpoint";
+  SpringRun run = spring_run();
+  NanGradientFrom objective(*run.model, run.data, run.config, 14);
+  try {
+    tasks::train(objective, tasks::with_train_config(checkpoint_loop(ckpt, false), run.config));
+    ADD_FAILURE() << "trained on a NaN gradient";
+  } catch (const tasks::TrainingDiverged& e) {
+    EXPECT_EQ(e.step(), 14);
+    const std::string what = e.what();
+    EXPECT_TRUE(what.starts_with("training diverged at step 14: the loss is ")) << what;
+    EXPECT_TRUE(
+        what.ends_with(fmt::format(" but its gradient is not finite; the last good "
+                                   "checkpoint (step 10) is kept in {}",
+                                   ckpt.string())))
+        << what;
+  }
+  for (const auto& p : run.model->parameters()) EXPECT_TRUE(p.value().allFinite());
+  EXPECT_EQ(tasks::read_train_state(ckpt).step, 10);
 }
 
 }  // namespace

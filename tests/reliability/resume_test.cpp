@@ -289,23 +289,25 @@ TEST_F(ResumeCli, SigtermStopsLikeSigint) {
   expect_complete_files(run);
 }
 
-// A loss that overflows (the baseline) and parameters that do (the HNN, whose loss stays finite
-// one step longer): either stops training at that step with the reason and keeps the checkpoint
-// of the step before, whose parameters are finite.
+// A loss that overflows (the baseline) and a gradient that does (the HNN, whose loss stays
+// finite on saturated units): either stops training at that step with the reason, before the
+// update, and keeps the checkpoint of the step before, whose parameters are finite.
 TEST(Divergence, StopsAtTheStepAndKeepsTheLastGoodCheckpoint) {
   const TempDir dir;
   for (const auto& [model, reason] :
        {std::pair<std::string, std::string>{"baseline", "the loss is inf"},
-        {"hnn", "the parameters are not finite"}}) {
+        {"hnn", "but its gradient is not finite"}}) {
     const fs::path run = dir / model;
     const Result r =
         run_hnn({"train", "spring", "--model", model, "--hidden", "8", "--steps", "10", "--lr",
                  "1e200", "--checkpoint-every", "1", "--quiet", "--out", run.string()},
                 dir.path());
     EXPECT_EQ(r.code, 1);
-    EXPECT_EQ(r.err, fmt::format("hnn: error: training diverged at step 2: {}; the last good "
-                                 "checkpoint (step 1) is kept in {}\n",
-                                 reason, checkpoint_dir(run).string()));
+    // The HNN's finite loss before `reason` depends on the weights: only its ends are checked.
+    EXPECT_TRUE(r.err.starts_with("hnn: error: training diverged at step 2: ")) << r.err;
+    EXPECT_TRUE(r.err.ends_with(fmt::format("{}; the last good checkpoint (step 1) is kept in {}\n",
+                                            reason, checkpoint_dir(run).string())))
+        << r.err;
     EXPECT_FALSE(fs::exists(run / "metrics.json"));
     EXPECT_FALSE(fs::exists(run / "params.bin"));
     const tasks::TrainState state = tasks::read_train_state(checkpoint_dir(run));
