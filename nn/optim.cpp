@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <limits>
 #include <set>
 #include <stdexcept>
 
@@ -181,7 +182,11 @@ void Adam<T>::update(std::size_t i, Matrix<T>& p, const Matrix<T>& g) {
       m = beta1 * m + (T(1) - beta1) * ga;
       v = beta2 * v + (T(1) - beta2) * ga.square();
     }
-    pa -= step_size * m / (v.sqrt() / bias_correction2_sqrt + eps);
+    // A gradient whose square overflows leaves v at inf, and torch's step there is m / inf = 0.
+    // Eigen's fast float sqrt (rsqrt and a Newton step) gives NaN for inf, which would turn the
+    // weight into NaN: inf is kept as it is.
+    const auto root = (v < std::numeric_limits<T>::infinity()).select(v.sqrt(), v);
+    pa -= step_size * m / (root / bias_correction2_sqrt + eps);
   });
 }
 

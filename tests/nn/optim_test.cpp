@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdlib>
 
 #include "malloc_counter.h"
@@ -55,6 +56,20 @@ TEST(Adam, FirstStepMovesEachParameterByLrTimesTheSignOfItsGradient) {
   EXPECT_EQ(adam.step_count(), 1);
   expect_row(adam.first_moment(0), {0.05, -0.1, 0.0}, 1e-16, "m");
   expect_row(adam.second_moment(0), {0.00025, 0.001, 0.0}, 1e-18, "v");
+}
+
+// A float gradient of 1e20 squares past float's range, so v is inf; torch's step there is
+// m / sqrt(inf) = 0. The entries run in whole SIMD packets, where Eigen's fast sqrt of inf is NaN.
+TEST(Adam, AGradientWhoseSquareOverflowsLeavesItsParameterWhereItWas) {
+  Var<float> p = Var<float>::leaf(nn::Matrix<float>::Ones(1, 64));
+  nn::Adam<float> adam({p}, {.lr = 0.1});
+  nn::Matrix<float> g = nn::Matrix<float>::Ones(1, 64);
+  for (Eigen::Index i = 0; i < 64; i += 3) g(0, i) = 1e20f;
+  adam.step({Var<float>::constant(g)});
+  for (Eigen::Index i = 0; i < 64; ++i) {
+    EXPECT_TRUE(std::isinf(adam.second_moment(0)(0, i)) == (i % 3 == 0)) << "v, element " << i;
+    EXPECT_NEAR(p.value()(0, i), i % 3 == 0 ? 1.0f : 0.9f, 1e-5) << "element " << i;
+  }
 }
 
 TEST(Adam, ThreeStepsMatchHandComputedValues) {
