@@ -181,10 +181,7 @@ void DynamicsModel<T>::visit_parameters(const ParameterVisitor<T>& visit) {
 
 template <typename T>
 Matrix<T> DynamicsModel<T>::field(const MatrixView<T>& x) const {
-  check_input("field", x.rows(), x.cols());
-  ad::TapeScope scope;
-  ad::NoGradGuard values_only;
-  return time_derivative(ad::Var<T>::constant(x)).value();
+  return values_of("field", x, [&](const ad::Var<T>& v) { return time_derivative(v); });
 }
 
 template <typename T>

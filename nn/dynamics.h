@@ -6,6 +6,7 @@
 #include <string_view>
 #include <vector>
 
+#include "autodiff/tape.h"
 #include "nn/constrained/constraints.h"
 #include "nn/enum_names.h"
 #include "nn/mlp.h"
@@ -162,6 +163,15 @@ class DynamicsModel : public Module<T> {
   DynamicsModel& operator=(DynamicsModel&&) noexcept = default;
   /// Throws ad::Error unless x is R x dim.
   void check_input(const char* what, Index rows, Index cols) const;
+  /// The values of f(x) (a function of a Var, e.g. a member's time_derivative) for input x,
+  /// checked as `what`, with nothing kept on the tape: field() and the like.
+  template <typename F>
+  Matrix<T> values_of(const char* what, const MatrixView<T>& x, const F& f) const {
+    check_input(what, x.rows(), x.cols());
+    ad::TapeScope scope;
+    ad::NoGradGuard values_only;
+    return f(ad::Var<T>::constant(x)).value();
+  }
   /// What the MLP sees: x divided by the input scales, each angle coordinate as (cos, sin)
   /// (columns: cos of the angles, sin of the angles, the other coordinates); x itself when
   /// there are neither. On the tape, so derivatives of any order pass through.

@@ -212,10 +212,8 @@ ad::Var<T> MassHnn<T>::observed_state(const ad::Var<T>& z) const {
 
 template <typename T>
 Matrix<T> MassHnn<T>::integrated_field(const MatrixView<T>& z) const {
-  this->check_input("integrated_field", z.rows(), z.cols());
-  ad::TapeScope scope;
-  ad::NoGradGuard values_only;
-  return integrated_derivative(ad::Var<T>::constant(z)).value();
+  return this->values_of("integrated_field", z,
+                         [&](const ad::Var<T>& v) { return integrated_derivative(v); });
 }
 
 template <typename T>
