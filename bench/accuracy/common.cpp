@@ -3,8 +3,10 @@
 
 #include <fmt/format.h>
 
+#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cmath>
+#include <iostream>
 #include <stdexcept>
 
 #include "physics/integrator.h"
@@ -118,18 +120,31 @@ nn::Hnn<double> train_spring_hnn(const SpringData& data, const std::vector<nn::I
   return model;
 }
 
-std::string arg_value(int argc, char** argv, const std::string& name, const std::string& fallback) {
-  for (int i = 1; i + 1 < argc; ++i) {
-    if (argv[i] == name) return argv[i + 1];
+int run_charts(int argc, char** argv, const std::string& program,
+               const std::vector<Chart>& charts) {
+  CLI::App app{program + ": writes its charts' CSV files (docs/speed_accuracy.md)", program};
+  std::string out = ".";
+  std::string only = "all";
+  int threads = 1;
+  bool quick = false;
+  std::vector<std::string> names{"all"};
+  for (const Chart& chart : charts) names.push_back(chart.name);
+  app.add_option("--out", out, "Folder of the CSV files")->capture_default_str();
+  app.add_option("--threads", threads, "Engine threads")
+      ->check(CLI::Range(1, 1024))
+      ->capture_default_str();
+  app.add_option("--only", only, "One chart")->check(CLI::IsMember(names))->capture_default_str();
+  app.add_flag("--quick", quick, "Small sizes, for a smoke run");
+  CLI11_PARSE(app, argc, argv);
+  try {
+    ad::set_num_threads(threads);
+    for (const Chart& chart : charts)
+      if (only == "all" || only == chart.name) chart.write(out, quick);
+  } catch (const std::exception& e) {
+    std::cerr << program << ": " << e.what() << "\n";
+    return 1;
   }
-  return fallback;
-}
-
-bool has_flag(int argc, char** argv, const std::string& name) {
-  for (int i = 1; i < argc; ++i) {
-    if (argv[i] == name) return true;
-  }
-  return false;
+  return 0;
 }
 
 }  // namespace hnn::accuracy

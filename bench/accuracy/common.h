@@ -64,8 +64,16 @@ SpringData spring_data(int trajectories, int points, double noise, std::uint64_t
 nn::Hnn<double> train_spring_hnn(const SpringData& data, const std::vector<nn::Index>& hidden,
                                  int steps, std::uint64_t seed, double* final_loss);
 
-/// Parses "--name value" pairs: value of `name` or `fallback`.
-std::string arg_value(int argc, char** argv, const std::string& name, const std::string& fallback);
-bool has_flag(int argc, char** argv, const std::string& name);
+/// One chart of a chart program: its --only name, and what writes its CSV files into a folder
+/// (`quick`: small sizes, for a smoke run).
+struct Chart {
+  std::string name;
+  std::function<void(const std::string& out, bool quick)> write;
+};
+
+/// A chart program's main: parses --out DIR, --threads N, --quick and --only NAME (a chart's name
+/// or all), refusing any other argument in one line, and writes the charts asked for. Returns the
+/// exit code.
+int run_charts(int argc, char** argv, const std::string& program, const std::vector<Chart>& charts);
 
 }  // namespace hnn::accuracy

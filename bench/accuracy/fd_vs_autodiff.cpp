@@ -136,17 +136,7 @@ void parameter_chart(const std::string& out, bool quick) {
 
 int main(int argc, char** argv) {
   using namespace hnn::accuracy;
-  const std::string out = arg_value(argc, argv, "--out", ".");
-  const bool quick = has_flag(argc, argv, "--quick");
-  const std::string only = arg_value(argc, argv, "--only", "all");
-  try {
-    hnn::ad::set_num_threads(std::stoi(arg_value(argc, argv, "--threads", "1")));
-    if (only == "all" || only == "error") error_chart(out, quick);
-    if (only == "all" || only == "dim") dimension_chart(out, quick);
-    if (only == "all" || only == "params") parameter_chart(out, quick);
-  } catch (const std::exception& e) {
-    std::cerr << "fd_vs_autodiff: " << e.what() << "\n";
-    return 1;
-  }
-  return 0;
+  return run_charts(
+      argc, argv, "fd_vs_autodiff",
+      {{"error", error_chart}, {"dim", dimension_chart}, {"params", parameter_chart}});
 }

@@ -285,16 +285,6 @@ void energy_chart(const std::string& out, bool quick) {
 
 int main(int argc, char** argv) {
   using namespace hnn::accuracy;
-  const std::string out = arg_value(argc, argv, "--out", ".");
-  const bool quick = has_flag(argc, argv, "--quick");
-  const std::string only = arg_value(argc, argv, "--only", "all");
-  try {
-    hnn::ad::set_num_threads(std::stoi(arg_value(argc, argv, "--threads", "1")));
-    if (only == "all" || only == "work") work_precision_chart(out, quick);
-    if (only == "all" || only == "energy") energy_chart(out, quick);
-  } catch (const std::exception& e) {
-    std::cerr << "work_precision: " << e.what() << "\n";
-    return 1;
-  }
-  return 0;
+  return run_charts(argc, argv, "work_precision",
+                    {{"work", work_precision_chart}, {"energy", energy_chart}});
 }
