@@ -18,7 +18,7 @@ rows "true"): every path cut into 5-point chunks, 800 of them drawn at random. M
 and run
   /usr/bin/python3 bench/compare/peer_hnn_first_steps.py RUN --angles 2
 It prints, per seed and form, the step at which a batch's loss was first not finite, or the
-loss after --steps steps.
+loss after --steps steps. Their full protocol is --steps 8000 --cosine-epochs 2000.
 """
 import argparse
 import csv
@@ -128,10 +128,13 @@ def chunk_loss(model, chunk, dt, form):
     return (torch.stack(states, 1) - chunk).abs().mean()
 
 
-def train(chunks, dt, angles, form, seed, steps):
+def train(chunks, dt, angles, form, seed, steps, cosine_epochs):
     torch.manual_seed(seed)
     model = TheirHnn(chunks.shape[-1] // 2, angles)
     optimiser = torch.optim.AdamW(model.parameters(), lr=3e-3, weight_decay=1e-4)
+    # Their pl_trainer anneals per epoch: CosineAnnealingLR(T_max=n_epochs, eta_min=0).
+    schedule = (torch.optim.lr_scheduler.CosineAnnealingLR(optimiser, T_max=cosine_epochs)
+                if cosine_epochs else None)
     order = torch.Generator().manual_seed(seed)
     step = 0
     while True:
@@ -143,25 +146,33 @@ def train(chunks, dt, angles, form, seed, steps):
             optimiser.zero_grad()
             loss.backward()
             optimiser.step()
+            if step % 1000 == 0:
+                print(f"  seed {seed} {form}: loss {float(loss):.3g} at step {step}", flush=True)
             if step == steps:
                 return f"trains on: loss {float(loss):.3g} at step {step}"
+        if schedule:
+            schedule.step()
 
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("run", help="an hnn run folder of the task in body coordinates")
     ap.add_argument("--angles", type=int, required=True, help="leading coordinates that are angles")
-    ap.add_argument("--seeds", type=int, default=6)
+    ap.add_argument("--seeds", type=int, default=6, help="how many seeds")
+    ap.add_argument("--first-seed", type=int, default=0)
     ap.add_argument("--steps", type=int, default=40)
     ap.add_argument("--forms", default="qp,qv")
+    ap.add_argument("--cosine-epochs", type=int, default=0,
+                    help="anneal lr to 0 over N epochs as their runs do (2000; 4 steps each); "
+                    "0: a constant lr")
     args = ap.parse_args()
     torch.set_num_threads(1)
     chunks, dt = read_chunks(args.run, 800, torch.Generator().manual_seed(0))
     print(f"{len(chunks)} chunks of {chunks.shape[1]} states, dim {chunks.shape[2]}, dt {dt:g}")
-    for seed in range(args.seeds):
+    for seed in range(args.first_seed, args.first_seed + args.seeds):
         for form in args.forms.split(","):
-            print(f"seed {seed} {form}: {train(chunks, dt, args.angles, form, seed, args.steps)}",
-                  flush=True)
+            outcome = train(chunks, dt, args.angles, form, seed, args.steps, args.cosine_epochs)
+            print(f"seed {seed} {form}: {outcome}", flush=True)
 
 
 if __name__ == "__main__":

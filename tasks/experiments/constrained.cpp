@@ -137,7 +137,7 @@ class ConstrainedTask : public FieldTask {
   }
   // Their pl_trainer trains and evaluates in float32 (datasets.py casts the trajectories with
   // .float()); float runs the 2-chain's default run in 304 s on 2 threads against 807 s in double,
-  // at the same error (docs/tasks.md, "Measured against Finzi et al.").
+  // at the same error (docs/constrained.md).
   Dtype default_dtype() const override { return Dtype::kFloat; }
   std::string table_note() const override {
     return fmt::format(
