@@ -3,6 +3,7 @@
 
 #include "tasks/train/checkpoint.h"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 
@@ -149,14 +150,9 @@ RunCheckpoints<T>::RunCheckpoints(fs::path dir, long every, long total_steps, js
 template <typename T>
 void RunCheckpoints<T>::save(long step, Objective<T>& objective, const nn::Adam<T>& adam,
                              const std::vector<CurvePoint>& curve, double seconds) {
-  for (const ad::Var<T>& p : adam.parameters()) {
-    if (!p.value().allFinite()) {
-      throw TrainingDiverged(
-          fmt::format("training diverged at step {}: the parameters are not finite{}", step,
-                      last_good()),
-          step);
-    }
-  }
+  const auto finite = [](const ad::Var<T>& p) { return p.value().allFinite(); };
+  if (!std::ranges::all_of(adam.parameters(), finite))
+    throw TrainingDiverged::at(step, "the parameters are not finite", last_good());
   TrainState state{.step = step,
                    .total_steps = total_steps_,
                    .sampler_state = objective.sampler().state(),

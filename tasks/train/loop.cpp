@@ -1,11 +1,13 @@
 #include "tasks/train/loop.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <memory>
 #include <numbers>
 #include <optional>
 #include <stdexcept>
+#include <string_view>
 
 #include "autodiff/check.h"
 #include "autodiff/grad.h"
@@ -128,22 +130,16 @@ double train_step(long step, Objective<T>& objective, nn::RowSplit<T>* split, nn
     loss = objective.batch_loss();
     return double(loss.item());
   });
-  if (!std::isfinite(value)) {
-    throw TrainingDiverged(
-        fmt::format("training diverged at step {}: the loss is {}{}", step, value, where), step);
-  }
+  const auto diverged = [&](std::string_view but) {  // formatted only when thrown
+    return TrainingDiverged::at(step, fmt::format("the loss is {}{}", value, but), where);
+  };
+  if (!std::isfinite(value)) throw diverged("");
   if (loss.defined()) ad::grad_into(loss, adam.parameters(), grads);
   // A finite loss can still have a non-finite gradient (a solve near singular, a saturated
   // activation times an overflow): stepping on it would turn every weight into NaN and stop the
   // run later, at whatever evaluates the model next, under another name.
-  for (const ad::Var<T>& g : grads) {
-    if (g.defined() && !g.value().allFinite()) {
-      throw TrainingDiverged(fmt::format("training diverged at step {}: the loss is {} but its "
-                                         "gradient is not finite{}",
-                                         step, value, where),
-                             step);
-    }
-  }
+  const auto finite = [](const ad::Var<T>& g) { return !g.defined() || g.value().allFinite(); };
+  if (!std::ranges::all_of(grads, finite)) throw diverged(" but its gradient is not finite");
   adam.step(grads);
   return value;
 }

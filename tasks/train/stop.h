@@ -21,10 +21,15 @@ class TrainingStopped : public std::runtime_error {
   long step_;
 };
 
-/// Training stopped because the loss or the parameters became NaN or infinite.
+/// Training stopped because the loss, its gradient or the parameters became NaN or infinite.
 class TrainingDiverged : public TrainingStopped {
  public:
   using TrainingStopped::TrainingStopped;
+  /// The one wording of every such stop: "training diverged at step N: <reason><where>", where
+  /// `where` says which checkpoint is kept.
+  static TrainingDiverged at(long step, const std::string& reason, const std::string& where) {
+    return {"training diverged at step " + std::to_string(step) + ": " + reason + where, step};
+  }
 };
 
 /// Training stopped on request (StopSignal) after `step()`, with a checkpoint written.
