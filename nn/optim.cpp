@@ -139,54 +139,59 @@ void Adam<T>::load_state(AdamState<T> state) {
   v_ = std::move(state.v);
 }
 
-namespace {
+// Not in an anonymous namespace: Adam<T>::update's lambda captures an AdamStep, and GCC warns of
+// a type local to this file inside a class template's member (-Wsubobject-linkage).
+namespace detail {
 
-// Parameters of at least this many elements are updated in blocks on the engine's threads (as
-// autodiff's large elementwise ops are): a 256 x 256 weight's update was a serial stretch of
-// some 40 us in the D-HNN's step, while the other thread waited.
-constexpr Eigen::Index kParallelElements = Eigen::Index(1) << 15;
-
+// One Adam step's constants, as torch.optim.Adam(W) computes them at step t.
 template <typename T>
-using Elements = Eigen::Map<Eigen::Array<T, Eigen::Dynamic, 1>>;
+struct AdamStep {
+  T beta1, beta2, step_size, bias_correction2_sqrt, eps, decay, shrink;
+  bool decoupled, l2;
+};
 
-}  // namespace
+// The step over elements [begin, end) of p, its gradient g and moments m and v, in one pass. A
+// plain loop, which GCC vectorises with the CPU's sqrt (-fno-math-errno), through pointers that do
+// not alias: Eigen 3.4 ran the select() below one element at a time, and its vectorised float
+// sqrt is approximate and NaN at inf. That was 2.3 ms of the pixel task's step (bench/nn_bench,
+// BM_AdamUpdate). Where v overflows to inf, the step is m / inf = 0, as torch's.
+template <typename T>
+void adam_elements(AdamStep<T> c, Eigen::Index begin, Eigen::Index end, T* __restrict p,
+                   const T* __restrict g, T* __restrict m, T* __restrict v) {
+  for (Eigen::Index k = begin; k < end; ++k) {
+    const T pk = c.decoupled ? p[k] * c.shrink : p[k];
+    const T gk = c.l2 ? g[k] + c.decay * pk : g[k];
+    const T mk = c.beta1 * m[k] + (T(1) - c.beta1) * gk;
+    const T vk = c.beta2 * v[k] + (T(1) - c.beta2) * (gk * gk);
+    m[k] = mk;
+    v[k] = vk;
+    p[k] = pk - c.step_size * mk / (std::sqrt(vk) / c.bias_correction2_sqrt + c.eps);
+  }
+}
+
+}  // namespace detail
 
 template <typename T>
 void Adam<T>::update(std::size_t i, Matrix<T>& p, const Matrix<T>& g) {
   const AdamOptions& o = options_[group_[i]];
   const double t = double(this->steps_);
-  const T beta1 = T(o.beta1), beta2 = T(o.beta2);
-  const T step_size = T(o.lr / (1.0 - std::pow(o.beta1, t)));
-  const T bias_correction2_sqrt = T(std::sqrt(1.0 - std::pow(o.beta2, t)));
-  const T eps = T(o.eps), decay = T(o.weight_decay);
-  const T shrink = T(1.0 - o.lr * o.weight_decay);  // AdamW's, in double as torch's
-  const bool decoupled = decay != T(0) && o.decoupled_weight_decay,
-             l2 = decay != T(0) && !decoupled;
-  // Elementwise, in blocks of whole SIMD packets (ad::element_block), so any split gives the
-  // same bits; each block runs m, v and p while they are in cache. One fused expression per
-  // buffer: no temporaries, so no allocation.
-  const Eigen::Index n = p.size();
-  const int parts = n >= kParallelElements ? ad::parts_for(n) : 1;
-  ad::parallel_for(parts, [&](int part) {
-    const ad::RowBlock r = ad::element_block(n, parts, part);
-    const auto at = [&](auto& x) { return Elements<T>(x.data() + r.begin, r.size()); };
-    const Eigen::Map<const Eigen::Array<T, Eigen::Dynamic, 1>> ga(g.data() + r.begin, r.size());
-    auto pa = at(p);
-    auto m = at(m_[i]);
-    auto v = at(v_[i]);
-    if (decoupled) pa *= shrink;
-    if (l2) {
-      m = beta1 * m + (T(1) - beta1) * (ga + decay * pa);
-      v = beta2 * v + (T(1) - beta2) * (ga + decay * pa).square();
-    } else {
-      m = beta1 * m + (T(1) - beta1) * ga;
-      v = beta2 * v + (T(1) - beta2) * ga.square();
-    }
-    // A gradient whose square overflows leaves v at inf, and torch's step there is m / inf = 0.
-    // Eigen's fast float sqrt (rsqrt and a Newton step) gives NaN for inf, which would turn the
-    // weight into NaN: inf is kept as it is.
-    const auto root = (v < std::numeric_limits<T>::infinity()).select(v.sqrt(), v);
-    pa -= step_size * m / (root / bias_correction2_sqrt + eps);
+  const T decay = T(o.weight_decay);
+  const bool decoupled = decay != T(0) && o.decoupled_weight_decay;
+  const detail::AdamStep<T> c{
+      .beta1 = T(o.beta1),
+      .beta2 = T(o.beta2),
+      .step_size = T(o.lr / (1.0 - std::pow(o.beta1, t))),
+      .bias_correction2_sqrt = T(std::sqrt(1.0 - std::pow(o.beta2, t))),
+      .eps = T(o.eps),
+      .decay = decay,
+      .shrink = T(1.0 - o.lr * o.weight_decay),  // AdamW's, in double as torch's
+      .decoupled = decoupled,
+      .l2 = decay != T(0) && !decoupled};
+  // In blocks of whole SIMD packets (ad::element_block), one per thread for large parameters, as
+  // autodiff's elementwise ops: any split gives the same bits.
+  ad::for_element_blocks(p.size(), [&](ad::RowBlock block) {
+    detail::adam_elements(c, block.begin, block.end, p.data(), g.data(), m_[i].data(),
+                          v_[i].data());
   });
 }
 

@@ -59,7 +59,8 @@ TEST(Adam, FirstStepMovesEachParameterByLrTimesTheSignOfItsGradient) {
 }
 
 // A float gradient of 1e20 squares past float's range, so v is inf; torch's step there is
-// m / sqrt(inf) = 0. The entries run in whole SIMD packets, where Eigen's fast sqrt of inf is NaN.
+// m / sqrt(inf) = 0. The entries run in whole SIMD packets, where an approximate sqrt (Eigen's
+// fast one: a reciprocal estimate and a Newton step) gives NaN for inf.
 TEST(Adam, AGradientWhoseSquareOverflowsLeavesItsParameterWhereItWas) {
   Var<float> p = Var<float>::leaf(nn::Matrix<float>::Ones(1, 64));
   nn::Adam<float> adam({p}, {.lr = 0.1});
