@@ -13,13 +13,14 @@ const Var<T>& in0(const Node<T>& n) {
   return n.inputs[0];
 }
 
-// Gradient of every reduction: the incoming gradient broadcast back (times a mean's 1/count).
+// Gradient of every reduction: the incoming gradient broadcast back (times a mean's 1/count). A
+// mean's factor scales the reduced gradient before it spreads, the same products on far fewer
+// elements (a 200 x 1568 pass fewer per pixel-task step).
 template <typename T>
 void reduce_backward(const Node<T>& n, const Var<T>& g, GradSink<T>& s) {
   const Var<T>& x = in0(n);
-  const Var<T> spread = broadcast_to(g, x.rows(), x.cols());
   const T factor = static_cast<T>(n.saved[0]);
-  s.add(0, factor == T(1) ? spread : scale(spread, factor));
+  s.add(0, broadcast_to(factor == T(1) ? g : scale(g, factor), x.rows(), x.cols()));
 }
 
 // value = reduce(x), with the gradient factor (1 for sums, 1/count for means).
@@ -86,9 +87,13 @@ Var<T> broadcast_to(const Var<T>& a, Eigen::Index rows, Eigen::Index cols) {
       detail::record<T>("broadcast_to", {a}, [](const Node<T>& n, const Var<T>& g, GradSink<T>& s) {
         s.add(0, sum_to(g, in0(n).rows(), in0(n).cols()));
       });
-  if (a.rows() == 1 && a.cols() == cols) {  // the common case: a row to every row
-    node.value.resize(rows, cols);
+  // A row to every row (a bias), or a column to every column (a row reduction's gradient), by
+  // vectorised fills; Eigen's replicate() indexes every element by a modulo, one at a time.
+  node.value.resize(rows, cols);
+  if (a.rows() == 1 && a.cols() == cols) {
     detail::fill_rows(node.value, a.value().row(0));
+  } else if (a.cols() == 1 && a.rows() == rows) {
+    for (Eigen::Index i = 0; i < rows; ++i) node.value.row(i).setConstant(a.value()(i, 0));
   } else {
     node.value = a.value().replicate(rows / a.rows(), cols / a.cols());
   }
