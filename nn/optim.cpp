@@ -3,7 +3,6 @@
 #include <fmt/format.h>
 
 #include <cmath>
-#include <limits>
 #include <set>
 #include <stdexcept>
 
@@ -152,8 +151,9 @@ struct AdamStep {
 
 // The step over elements [begin, end) of p, its gradient g and moments m and v, in one pass. A
 // plain loop, which GCC vectorises with the CPU's sqrt (-fno-math-errno), through pointers that do
-// not alias: Eigen 3.4 ran the select() below one element at a time, and its vectorised float
-// sqrt is approximate and NaN at inf. That was 2.3 ms of the pixel task's step (bench/nn_bench,
+// not alias. As Eigen expressions, the select() that kept an overflowed v at inf ran one element
+// at a time (Eigen 3.4 has no packet select), and without it Eigen's vectorised float sqrt,
+// approximate, turns inf into NaN: 2.3 ms of the pixel task's step (bench/nn_bench,
 // BM_AdamUpdate). Where v overflows to inf, the step is m / inf = 0, as torch's.
 template <typename T>
 void adam_elements(AdamStep<T> c, Eigen::Index begin, Eigen::Index end, T* __restrict p,
