@@ -87,15 +87,15 @@ Var<T> broadcast_to(const Var<T>& a, Eigen::Index rows, Eigen::Index cols) {
       detail::record<T>("broadcast_to", {a}, [](const Node<T>& n, const Var<T>& g, GradSink<T>& s) {
         s.add(0, sum_to(g, in0(n).rows(), in0(n).cols()));
       });
-  // A row to every row (a bias), or a column to every column (a row reduction's gradient), by
-  // vectorised fills; Eigen's replicate() indexes every element by a modulo, one at a time.
+  // Each dimension is a's or 1, so a is a scalar, a row (a bias) or a column (a row reduction's
+  // gradient): each by vectorised fills. Eigen's replicate() indexed every element by a modulo.
   node.value.resize(rows, cols);
-  if (a.rows() == 1 && a.cols() == cols) {
+  if (a.value().size() == 1) {
+    node.value.setConstant(a.value()(0, 0));
+  } else if (a.rows() == 1) {
     detail::fill_rows(node.value, a.value().row(0));
-  } else if (a.cols() == 1 && a.rows() == rows) {
-    for (Eigen::Index i = 0; i < rows; ++i) node.value.row(i).setConstant(a.value()(i, 0));
   } else {
-    node.value = a.value().replicate(rows / a.rows(), cols / a.cols());
+    for (Eigen::Index i = 0; i < rows; ++i) node.value.row(i).setConstant(a.value()(i, 0));
   }
   return Var<T>::of(node);
 }
