@@ -339,6 +339,11 @@ json run(const cmp::Options& o, const cmp::Data& data) {
 int main(int argc, char** argv) {
   try {
     const cmp::Options o = cmp::parse_options(argc, argv, "hnn_train_step");
+    if (!o.init.empty()) {  // the torches read hnn's parameters; hnn starts from its own seed's
+      throw std::invalid_argument("--init is for the torch programs: hnn starts from seed " +
+                                  std::to_string(o.seed) +
+                                  "'s parameters (--save-init writes them)");
+    }
     if (!o.fma_peak.empty()) {
       if (o.fma_peak != "float32" && o.fma_peak != "float64")
         throw std::invalid_argument("--fma-peak takes float32 or float64, got " + o.fma_peak);
