@@ -1,9 +1,12 @@
 // One tanh kernel: the elementwise op and the fused MLP kernels give the same bits, whatever the
 // batch size, the thread count (row blocks start anywhere in memory) or the scalar type.
 
+#include "autodiff/tanh_kernel.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <limits>
 
 #include "autodiff/autodiff.h"
@@ -102,6 +105,32 @@ TEST(TanhKernel, DoubleIsWithinAFewUlpsOfOneOfTheTrueTanh) {
     }
   }
   EXPECT_LT(worst, 4 * std::numeric_limits<double>::epsilon());
+}
+
+// A machine with AVX-512 computes double tanh 8 lanes at a time, one with AVX2 alone 4 at a time:
+// the same operations lane by lane, so a model gives the same bits on either.
+TEST(TanhKernel, EightLanesAndFourGiveTheSameBits) {
+#if defined(HNN_SIMD_DOUBLE_TANH) && defined(EIGEN_VECTORIZE_AVX512)
+  namespace d = ad::detail;
+  const double inf = std::numeric_limits<double>::infinity();
+  ad::Matrix<double> x = random_matrix(1, 4096, 35, -25, 25);
+  const double special[] = {0.0, -0.0, 1e-300, -1e-17, 19.9, 20.1, -800, inf, -inf, std::nan("")};
+  for (std::size_t i = 0; i < std::size(special); ++i) x(0, Eigen::Index(i)) = special[i];
+  alignas(64) double four[8], eight[8];
+  int differ = 0;
+  for (Eigen::Index i = 0; i < x.cols(); i += 8) {
+    const double* in = x.data() + i;
+    for (int half : {0, 4}) {
+      d::Avx2Doubles::store(four + half,
+                            d::tanh_packet<d::Avx2Doubles>(d::Avx2Doubles::load(in + half)));
+    }
+    d::Avx512Doubles::store(eight, d::tanh_packet<d::Avx512Doubles>(d::Avx512Doubles::load(in)));
+    differ += std::memcmp(four, eight, sizeof four) != 0;
+  }
+  EXPECT_EQ(differ, 0) << "of " << x.cols() / 8 << " packets of 8";
+#else
+  GTEST_SKIP() << "this build has no AVX-512 double tanh";
+#endif
 }
 
 }  // namespace
