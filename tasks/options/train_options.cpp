@@ -35,7 +35,10 @@ const TrainOption kOptions[] = {
     {.name = "model",
      .kind = ValueKind::kChoice,
      .help = "hnn, baseline, dhnn (the dissipative HNN: H and a dissipation potential D) or lnn "
-             "(the Lagrangian NN: L(q, dq/dt))",
+             "(the Lagrangian NN: L(q, dq/dt)); on the constrained tasks (chain-pendulum-N, "
+             "coupled-pendulums, magnet-pendulum, gyroscope, rotor) also chnn and clnn (Finzi "
+             "et al.'s constrained HNN and LNN: a learned V(x) in Cartesian coordinates) and "
+             "hnn-mass (their HNN: a learned V(q) and M(q) in angles)",
      .default_shown = "hnn",
      .sweep_rank = 1,
      .lands = Lands::kModel,
