@@ -70,6 +70,8 @@ class FieldRun : public FieldModelRun {
       folder->write_text("rollout.csv", tasks::rollout_csv(e.rollouts, nn::to_string(s_.model)));
     json m = e.metrics;
     m["training"] = training_.loss().to_json();
+    if (training_.loss().rollout && task_.has_truth())
+      m["truth_rollout_loss"] = number(training_.truth_loss(truth()));
     if (stretches_ && !stretches_->test.empty()) {
       m.update(held_out_stretch_metrics(dynamics(), *stretches_,
                                         {.per_body = task_.coordinates_per_body(),

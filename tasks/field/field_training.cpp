@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 
 #include "nn/sampled/sampled_fit.h"
 #include "tasks/task.h"
@@ -37,6 +38,22 @@ FieldTraining::FieldTraining(const RolloutLossConfig& loss, const SplitStretches
   HNN_TASKS_CHECK(train.batch_size <= train_windows_.count(),
                   "--batch {} is larger than the {} rollout windows of the training set",
                   train.batch_size, train_windows_.count());
+}
+
+double FieldTraining::truth_loss(const physics::System& truth) const {
+  if (!loss_.rollout || loss_.integrator == RolloutIntegrator::kMidpoint) return NAN;
+  const KnownField field = [&](const Batch& z, Batch& dzdt) { truth.vector_field(z, dzdt); };
+  const RolloutWindows& w = train_windows_;
+  Batch z = w.start;
+  double total = 0;
+  for (std::size_t j = 0; j < w.next.size(); ++j) {
+    const Batch h = w.step[j] / double(substeps_);
+    for (int s = 0; s < substeps_; ++s) z = known_field_step(field, z, h, loss_.integrator);
+    const Batch e = z - w.next[j];
+    total +=
+        loss_.norm == RolloutNorm::kL1 ? e.cwiseAbs().mean() : e.squaredNorm() / double(e.size());
+  }
+  return total / double(w.next.size());
 }
 
 namespace {

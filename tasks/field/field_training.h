@@ -10,6 +10,7 @@
 #include <string>
 
 #include "nn/dynamics.h"
+#include "physics/system.h"
 #include "tasks/data/dataset.h"
 #include "tasks/data/stretch.h"
 #include "tasks/evaluate/stretch_predictions.h"
@@ -45,6 +46,12 @@ class FieldTraining {
                     const LoopOptions& loop) const;
 
   const RolloutLossConfig& loss() const { return loss_; }
+  /// The rollout loss that `truth` (the true system, in the model's coordinates and time unit)
+  /// has through the training's integrator, steps and norm over every training window: the
+  /// integrator's own error, below which a model's training loss falls only by learning to undo
+  /// it. (A mass HNN steps (q, p) where this steps the observed (q, dq/dt): for it a guide.)
+  /// NaN without the rollout loss, and for the implicit midpoint.
+  double truth_loss(const physics::System& truth) const;
   /// How the trained model steps along held-out stretches: as it trained through an integrator,
   /// or, trained on dx/dt, by dopri5 (the best use of a learned field).
   StretchStepping stepping() const {

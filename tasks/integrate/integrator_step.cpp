@@ -42,41 +42,70 @@ Var<T> join(const Var<T>& q, const Var<T>& p) {
   return ad::concat_cols(parts);
 }
 
+// The explicit methods take the field as any callable f(z) -> dz/dt on the tape: a model's
+// integrated_derivative (integrator_step), or a known system's values (known_field_step).
+
 // Kick-drift-kick (the file header): three field calls, each on the whole state.
-template <typename T>
-Var<T> leapfrog(const nn::DynamicsModel<T>& model, const Var<T>& x, const Var<T>& h) {
+template <typename T, typename Field>
+Var<T> leapfrog(const Field& f, const Var<T>& x, const Var<T>& h) {
   const Eigen::Index n = x.cols() / 2;
   const Var<T> half = h * T(0.5);
   const Var<T> q = ad::slice_cols(x, 0, n);
-  const Var<T> p_half =
-      ad::slice_cols(x, n, n) + half * ad::slice_cols(model.integrated_derivative(x), n, n);
-  const Var<T> q1 = q + h * ad::slice_cols(model.integrated_derivative(join(q, p_half)), 0, n);
-  const Var<T> p1 =
-      p_half + half * ad::slice_cols(model.integrated_derivative(join(q1, p_half)), n, n);
+  const Var<T> p_half = ad::slice_cols(x, n, n) + half * ad::slice_cols(f(x), n, n);
+  const Var<T> q1 = q + h * ad::slice_cols(f(join(q, p_half)), 0, n);
+  const Var<T> p1 = p_half + half * ad::slice_cols(f(join(q1, p_half)), n, n);
   return join(q1, p1);
 }
 
-template <typename T>
-Var<T> rk4(const nn::DynamicsModel<T>& model, const Var<T>& x, const Var<T>& h) {
+template <typename T, typename Field>
+Var<T> rk4(const Field& f, const Var<T>& x, const Var<T>& h) {
   const Var<T> half = h * T(0.5);
-  const Var<T> k1 = model.integrated_derivative(x);
-  const Var<T> k2 = model.integrated_derivative(x + half * k1);
-  const Var<T> k3 = model.integrated_derivative(x + half * k2);
-  const Var<T> k4 = model.integrated_derivative(x + h * k3);
+  const Var<T> k1 = f(x);
+  const Var<T> k2 = f(x + half * k1);
+  const Var<T> k3 = f(x + half * k2);
+  const Var<T> k4 = f(x + h * k3);
   return x + (h * T(1.0 / 6.0)) * (k1 + T(2) * k2 + T(2) * k3 + k4);
 }
 
 // Kutta's 3/8 rule (Butcher tableau c = 0, 1/3, 2/3, 1; b = 1/8, 3/8, 3/8, 1/8): torchdiffeq's
 // "rk4", which the peers train through. Fourth order as the classic one, with other error
 // terms, so a model trained through one has learned to undo that one's truncation error.
-template <typename T>
-Var<T> rk4_38(const nn::DynamicsModel<T>& model, const Var<T>& x, const Var<T>& h) {
+template <typename T, typename Field>
+Var<T> rk4_38(const Field& f, const Var<T>& x, const Var<T>& h) {
   const Var<T> third = h * T(1.0 / 3.0);
-  const Var<T> k1 = model.integrated_derivative(x);
-  const Var<T> k2 = model.integrated_derivative(x + third * k1);
-  const Var<T> k3 = model.integrated_derivative(x + h * k2 - third * k1);
-  const Var<T> k4 = model.integrated_derivative(x + h * (k1 - k2 + k3));
+  const Var<T> k1 = f(x);
+  const Var<T> k2 = f(x + third * k1);
+  const Var<T> k3 = f(x + h * k2 - third * k1);
+  const Var<T> k4 = f(x + h * (k1 - k2 + k3));
   return x + (h * T(1.0 / 8.0)) * (k1 + T(3) * (k2 + k3) + k4);
+}
+
+// Yoshida (1990): leapfrog steps of w1 h, w0 h and w1 h, w1 = 1 / (2 - 2^(1/3)), w0 = 1 - 2 w1.
+template <typename T, typename Field>
+Var<T> yoshida4(const Field& f, const Var<T>& x, const Var<T>& h) {
+  const double w1 = 1.0 / (2.0 - std::cbrt(2.0)), w0 = 1.0 - 2.0 * w1;
+  const Var<T> outer = h * T(w1);
+  Var<T> y = leapfrog(f, x, outer);
+  y = leapfrog(f, y, h * T(w0));
+  return leapfrog(f, y, outer);
+}
+
+// Every method but the midpoint, whose solve needs the field's Jacobian.
+template <typename T, typename Field>
+Var<T> explicit_step(const Field& f, const Var<T>& x, const Var<T>& h, RolloutIntegrator method) {
+  switch (method) {
+    case RolloutIntegrator::kRk4:
+      return rk4(f, x, h);
+    case RolloutIntegrator::kRk38:
+      return rk4_38(f, x, h);
+    case RolloutIntegrator::kLeapfrog:
+      return leapfrog(f, x, h);
+    case RolloutIntegrator::kYoshida4:
+      return yoshida4(f, x, h);
+    case RolloutIntegrator::kMidpoint:
+      break;
+  }
+  throw Error(fmt::format("the {} step is not explicit", to_string(method)));
 }
 
 template <typename T>
@@ -240,25 +269,24 @@ Matrix<T> midpoint_solve(const nn::DynamicsModel<T>& model, const Matrix<T>& x0,
 template <typename T>
 Var<T> integrator_step(const nn::DynamicsModel<T>& model, const Var<T>& x, const Var<T>& h,
                        RolloutIntegrator method, const MidpointSolve& solve) {
-  switch (method) {
-    case RolloutIntegrator::kRk4:
-      return rk4(model, x, h);
-    case RolloutIntegrator::kRk38:
-      return rk4_38(model, x, h);
-    case RolloutIntegrator::kLeapfrog:
-      return leapfrog(model, x, h);
-    case RolloutIntegrator::kYoshida4: {
-      // Yoshida (1990): w1 = 1 / (2 - 2^(1/3)), w0 = 1 - 2 w1.
-      const double w1 = 1.0 / (2.0 - std::cbrt(2.0)), w0 = 1.0 - 2.0 * w1;
-      const Var<T> outer = h * T(w1);
-      Var<T> y = leapfrog(model, x, outer);
-      y = leapfrog(model, y, h * T(w0));
-      return leapfrog(model, y, outer);
-    }
-    case RolloutIntegrator::kMidpoint:
-      return midpoint(model, x, h, solve);
-  }
-  throw Error("unknown rollout integrator");
+  if (method == RolloutIntegrator::kMidpoint) return midpoint(model, x, h, solve);
+  return explicit_step([&](const Var<T>& z) { return model.integrated_derivative(z); }, x, h,
+                       method);
+}
+
+Matrix<double> known_field_step(const KnownField& field, const Matrix<double>& x,
+                                const Matrix<double>& h, RolloutIntegrator method) {
+  HNN_TASKS_CHECK(method != RolloutIntegrator::kMidpoint,
+                  "a known field is not stepped by the implicit midpoint: its solve needs the "
+                  "field's Jacobian");
+  ad::TapeScope scope;
+  ad::NoGradGuard values_only;
+  const auto f = [&](const Var<double>& z) {
+    Matrix<double> dz;
+    field(z.value(), dz);
+    return Var<double>::constant(dz);
+  };
+  return explicit_step(f, Var<double>::constant(x), Var<double>::constant(h), method).value();
 }
 
 #define HNN_INSTANTIATE(T)                                                                   \

@@ -22,6 +22,7 @@
 // evaluation (a rollout-trained model along held-out stretches, tasks/evaluate/held_out.h), so
 // they sit in a folder below both.
 
+#include <functional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -55,6 +56,16 @@ template <typename T>
 ad::Var<T> integrator_step(const nn::DynamicsModel<T>& model, const ad::Var<T>& x,
                            const ad::Var<T>& h, RolloutIntegrator method,
                            const MidpointSolve& solve = {});
+
+/// A known field, z -> dz/dt on a batch of rows (a true system's vector_field).
+using KnownField = std::function<void(const ad::Matrix<double>& z, ad::Matrix<double>& dzdt)>;
+
+/// One step of size h (a column) of an explicit `method` through a known field, as values: the
+/// formulas integrator_step runs, so that the true system through a run's integrator is measured
+/// alike (FieldTraining::truth_loss). Throws Error for the midpoint, whose solve needs the
+/// field's Jacobian.
+ad::Matrix<double> known_field_step(const KnownField& field, const ad::Matrix<double>& x,
+                                    const ad::Matrix<double>& h, RolloutIntegrator method);
 
 /// The converged implicit-midpoint step as plain values, off the tape: x1 with
 /// x1 = x0 + h f((x0 + x1)/2) for every row (h a column). The map the on-tape step differentiates.

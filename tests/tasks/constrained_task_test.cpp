@@ -84,6 +84,9 @@ TEST(ConstrainedTask, RunsEndToEndWithTheMetricItsFloorAndTheFailedCount) {
   EXPECT_EQ(m["training"]["loss"], "rollout");
   EXPECT_EQ(m["training"]["norm"], "l1");
   EXPECT_EQ(m["training"]["horizon"], 4);
+  // The truth through RK4 at the peer's step: about 2.4e-5 over the 2-chain's 800 windows.
+  EXPECT_GT(m["truth_rollout_loss"].get<double>(), 1e-7);
+  EXPECT_LT(m["truth_rollout_loss"].get<double>(), 1e-3);
 }
 
 // A run's rollouts from x0 in its own coordinates (those of `twin`, a System with to_cartesian),

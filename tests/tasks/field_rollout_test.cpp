@@ -4,8 +4,12 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
+#include "physics/oscillators.h"
 #include "tasks/experiments/registry.h"
 #include "tasks/field/field_task.h"
+#include "tasks/field/field_training.h"
 #include "tasks/run.h"
 #include "test_configs.h"
 
@@ -94,6 +98,44 @@ TEST(FieldRollout, SubStepsDivideTheIntervalOrAreRefused) {
   EXPECT_THROW(
       make_field_task("damped-spring")->open(settings("damped-spring", {{"loss", "rollout"}})),
       Error);
+}
+
+// The spring H = q^2 + p^2 sampled exactly every `interval` (q = r cos(2t + a), p = -r sin(2t +
+// a)): 6 trajectories of 9 samples each, the first 4 for training.
+SplitStretches exact_spring(double interval) {
+  SplitStretches st;
+  for (int i = 0; i < 6; ++i) {
+    const double r = 0.3 + 0.2 * i, a = 0.9 * i;
+    Stretch s{Eigen::VectorXd(9), Batch(9, 2)};
+    for (int k = 0; k < 9; ++k) {
+      const double t = k * interval;
+      s.t(k) = t;
+      s.x.row(k) << r * std::cos(2 * t + a), -r * std::sin(2 * t + a);
+    }
+    (i < 4 ? st.train : st.test).push_back(std::move(s));
+  }
+  return st;
+}
+
+// The truth's rollout loss is its integrator's error alone: on exact samples, RK4's global error
+// falls as h^4, so half the step takes the L1 loss down 16-fold; the midpoint has none.
+TEST(FieldRollout, TheTruthsRolloutLossIsTheIntegratorsErrorAndFallsWithItsStep) {
+  const physics::Spring spring;  // H = q^2 + p^2, the samples' motion
+  const SplitStretches st = exact_spring(0.1);
+  const auto truth_loss = [&](double dt, RolloutIntegrator integrator) {
+    const RolloutLossConfig loss{.rollout = true,
+                                 .horizon = 4,
+                                 .integrator = integrator,
+                                 .dt = dt,
+                                 .norm = RolloutNorm::kL1};
+    return FieldTraining(loss, &st, TrainConfig{}, "spring").truth_loss(spring);
+  };
+  const double whole = truth_loss(0, RolloutIntegrator::kRk4);
+  const double half = truth_loss(0.05, RolloutIntegrator::kRk4);
+  EXPECT_GT(whole, 1e-8);
+  EXPECT_LT(whole, 1e-4);
+  EXPECT_NEAR(whole / half, 16.0, 2.0);
+  EXPECT_TRUE(std::isnan(truth_loss(0, RolloutIntegrator::kMidpoint)));
 }
 
 }  // namespace

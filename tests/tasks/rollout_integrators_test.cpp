@@ -22,10 +22,10 @@ using Var = ad::Var<double>;
 using Matrix = ad::Matrix<double>;
 
 // A "model" whose field is written by hand with the engine's ops.
-class KnownField : public nn::DynamicsModel<double> {
+class KnownFieldModel : public nn::DynamicsModel<double> {
  public:
   using Fn = std::function<Var(const Var&)>;
-  explicit KnownField(Fn f) : DynamicsModel(config(), mlp()), f_(std::move(f)) {}
+  explicit KnownFieldModel(Fn f) : DynamicsModel(config(), mlp()), f_(std::move(f)) {}
   Var time_derivative(const Var& x) const override { return f_(x); }
   Matrix field(const ad::MatrixView<double>& x) const override {
     ad::TapeScope scope;
@@ -48,18 +48,18 @@ Var q_of(const Var& x) { return ad::slice_cols(x, 0, 1); }
 Var p_of(const Var& x) { return ad::slice_cols(x, 1, 1); }
 
 // H = (q^2 + p^2) / 2.
-KnownField spring() {
-  return KnownField([](const Var& x) { return ad::concat_cols<double>({p_of(x), -q_of(x)}); });
+KnownFieldModel spring() {
+  return KnownFieldModel([](const Var& x) { return ad::concat_cols<double>({p_of(x), -q_of(x)}); });
 }
 // H = p^2 / 2 + 1 - cos q.
-KnownField pendulum() {
-  return KnownField([](const Var& x) {
+KnownFieldModel pendulum() {
+  return KnownFieldModel([](const Var& x) {
     return ad::concat_cols<double>({p_of(x), -ad::sin(q_of(x))});
   });
 }
 // H = (q^2 + p^2) / 2 + q^2 p^2 / 2: not separable.
-KnownField coupled() {
-  return KnownField([](const Var& x) {
+KnownFieldModel coupled() {
+  return KnownFieldModel([](const Var& x) {
     const Var q = q_of(x), p = p_of(x);
     return ad::concat_cols<double>({p + q * q * p, -(q + q * p * p)});
   });
@@ -85,7 +85,7 @@ double measured_order(const nn::DynamicsModel<double>& model, RolloutIntegrator 
 }
 
 TEST(RolloutIntegrators, HaveTheirOrdersOnSeparableSystems) {
-  for (const KnownField& model : {spring(), pendulum()}) {
+  for (const KnownFieldModel& model : {spring(), pendulum()}) {
     EXPECT_NEAR(measured_order(model, RolloutIntegrator::kLeapfrog, 16), 2.0, 0.15);
     EXPECT_NEAR(measured_order(model, RolloutIntegrator::kMidpoint, 16), 2.0, 0.15);
     EXPECT_NEAR(measured_order(model, RolloutIntegrator::kYoshida4, 8), 4.0, 0.3);
@@ -97,7 +97,7 @@ TEST(RolloutIntegrators, HaveTheirOrdersOnSeparableSystems) {
 // Kutta's 3/8 rule (torchdiffeq's "rk4") by its tableau, one step of the pendulum's field by
 // hand; on a nonlinear field it is not the classic RK4.
 TEST(RolloutIntegrators, TheThreeEighthsRuleIsKuttasTableau) {
-  const KnownField model = pendulum();
+  const KnownFieldModel model = pendulum();
   const Matrix x0{{0.9, -0.3}};
   const double h = 0.2;
   const auto f = [&](const Matrix& x) { return model.field(x); };
@@ -112,7 +112,7 @@ TEST(RolloutIntegrators, TheThreeEighthsRuleIsKuttasTableau) {
 // Not separable: the midpoint keeps order 2 and RK4 order 4; the explicit kick-drift-kick drops
 // to order 1 (tasks/integrate/integrator_step.h), and Yoshida's composition of it with it.
 TEST(RolloutIntegrators, OnANonSeparableFieldLeapfrogIsFirstOrder) {
-  const KnownField model = coupled();
+  const KnownFieldModel model = coupled();
   EXPECT_NEAR(measured_order(model, RolloutIntegrator::kMidpoint, 16), 2.0, 0.15);
   EXPECT_NEAR(measured_order(model, RolloutIntegrator::kRk4, 8), 4.0, 0.3);
   EXPECT_NEAR(measured_order(model, RolloutIntegrator::kRk38, 8), 4.0, 0.3);
@@ -123,7 +123,7 @@ TEST(RolloutIntegrators, OnANonSeparableFieldLeapfrogIsFirstOrder) {
 // H = (q^2 + p^2)/2 over 2000 steps of h = 0.5 (160 periods): the symplectic methods keep the
 // energy error bounded, without trend; RK4's energy decays steadily.
 TEST(RolloutIntegrators, SymplecticOnesConserveAQuadraticEnergyWhereRk4Drifts) {
-  const KnownField model = spring();
+  const KnownFieldModel model = spring();
   const auto energy = [](const Matrix& x) { return 0.5 * x.squaredNorm(); };
   const Matrix x0{{1.0, 0.0}};
   for (RolloutIntegrator method : {RolloutIntegrator::kLeapfrog, RolloutIntegrator::kYoshida4,
@@ -200,7 +200,7 @@ TEST(RolloutIntegrators, MidpointGradientMatchesFiniteDifferencesOfTheConvergedM
 }
 
 TEST(RolloutIntegrators, AMidpointStepThatCannotConvergeNamesItsRow) {
-  const KnownField model = spring();
+  const KnownFieldModel model = spring();
   const Matrix x0{{1.0, 0.0}, {0.5, 0.5}};
   try {
     midpoint_solve<double>(model, x0, Matrix{{0.1}, {0.1}}, {.max_iterations = 1});
@@ -216,6 +216,23 @@ TEST(RolloutIntegrators, NamesAreParsedAndUnknownOnesRefused) {
   for (const std::string& name : rollout_integrator_names())
     EXPECT_EQ(to_string(parse_rollout_integrator(name)), name);
   EXPECT_THROW(parse_rollout_integrator("euler"), Error);
+}
+
+// known_field_step runs integrator_step's formulas: a field's values through it give the bits a
+// model with that field gives, and the midpoint, which needs the field's Jacobian, is refused.
+TEST(RolloutIntegrators, AKnownFieldStepsByTheSameFormulasAsAModel) {
+  const KnownFieldModel model = coupled();
+  const KnownField field = [&](const Matrix& z, Matrix& dzdt) { dzdt = model.field(z); };
+  const Matrix x0{{0.7, 0.4}, {-0.2, 0.9}};
+  const Matrix h{{0.1}, {0.05}};
+  for (RolloutIntegrator method : {RolloutIntegrator::kRk4, RolloutIntegrator::kRk38,
+                                   RolloutIntegrator::kLeapfrog, RolloutIntegrator::kYoshida4}) {
+    ad::TapeScope scope;
+    ad::NoGradGuard values;
+    const Matrix want = integrator_step(model, Var::constant(x0), Var::constant(h), method).value();
+    EXPECT_EQ(known_field_step(field, x0, h, method), want) << to_string(method);
+  }
+  EXPECT_THROW(known_field_step(field, x0, h, RolloutIntegrator::kMidpoint), Error);
 }
 
 }  // namespace

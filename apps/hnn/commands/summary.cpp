@@ -218,6 +218,23 @@ std::string constrained_line(const json& m) {
                             number_at(m, "cartesian_error_rollouts").value_or(NAN));
 }
 
+// What the training's integrator costs on its own: the true system's rollout loss through it,
+// which a model's training loss goes below only by learning to undo that error, beside the loss
+// the training ended at.
+std::string integrator_line(const json& m) {
+  const auto truth = number_at(m, "truth_rollout_loss");
+  const auto training = m.find("training");
+  if (!truth || training == m.end() || !training->is_object()) return "";
+  const std::string dt = text_at(*training, "dt");
+  std::string line = fmt::format(
+      "  integrator the true system through {} ({}) has rollout loss {:.3g}",
+      text_at(*training, "integrator"),
+      dt == "sampling interval" ? "a step per sampling interval" : "steps of " + dt, *truth);
+  if (const auto last = number_at(m, "final_batch_loss"))
+    line += fmt::format("; the training's last batch {:.3g}", *last);
+  return line + "\n";
+}
+
 // Learned masses (--masses learned) beside the system's, and how far apart they move it (the
 // motion fixes only part of them: metrics.json's masses_note).
 std::string masses_line(const json& m) {
@@ -249,8 +266,8 @@ std::string timing_line(const json& m) {
 
 std::string metrics_summary(const json& m) {
   return heading_line(m) + "\n" + loss_lines(m) + prediction_line(m) + constrained_line(m) +
-         masses_line(m) + skipped_rollouts_line(m) + hamiltonian_line(m) + energy_lines(m) +
-         fit_line(m) + timing_line(m);
+         integrator_line(m) + masses_line(m) + skipped_rollouts_line(m) + hamiltonian_line(m) +
+         energy_lines(m) + fit_line(m) + timing_line(m);
 }
 
 void print_warnings(const json& metrics) {
