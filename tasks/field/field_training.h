@@ -48,8 +48,9 @@ class FieldTraining {
   const RolloutLossConfig& loss() const { return loss_; }
   /// The rollout loss that `truth` (the true system, in the model's coordinates and time unit)
   /// has through the training's integrator, steps and norm over every training window: the
-  /// integrator's own error, below which a model's training loss falls only by learning to undo
-  /// it. (A mass HNN steps (q, p) where this steps the observed (q, dq/dt): for it a guide.)
+  /// integrator's own error plus the data's noise, below which a model's training loss falls
+  /// only by fitting the noise or undoing the integrator's error. (A mass HNN steps (q, p) where
+  /// this steps the observed (q, dq/dt): for it a guide.)
   /// NaN without the rollout loss, and for the implicit midpoint.
   double truth_loss(const physics::System& truth) const;
   /// How the trained model steps along held-out stretches: as it trained through an integrator,

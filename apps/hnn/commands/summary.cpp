@@ -218,9 +218,9 @@ std::string constrained_line(const json& m) {
                             number_at(m, "cartesian_error_rollouts").value_or(NAN));
 }
 
-// What the training's integrator costs on its own: the true system's rollout loss through it,
-// which a model's training loss goes below only by learning to undo that error, beside the loss
-// the training ended at.
+// What the training's integrator (and the data's noise) cost on their own: the true system's
+// rollout loss through it, which a model's training loss goes below only by fitting the noise or
+// undoing the integrator's error, beside the loss the training ended at.
 std::string integrator_line(const json& m) {
   const auto truth = number_at(m, "truth_rollout_loss");
   const auto training = m.find("training");
