@@ -29,6 +29,16 @@ std::vector<std::string> run_warnings(const std::vector<CurvePoint>& curve, cons
           which, curve_loss(first), first.step, curve_loss(last), last.step));
     }
   }
+  const auto truth = metrics.find("truth_rollout_loss");
+  if (!curve.empty() && truth != metrics.end() && truth->is_number() &&
+      truth->get<double>() > kTruthLossRatio * curve.back().train_loss) {
+    warnings.push_back(fmt::format(
+        "the true system's own rollout loss through the training's integrator is {:.3g}, over "
+        "{:g} times the training's last loss ({:.3g}): at this step the integrator cannot follow "
+        "the true motion on some training windows, and the model learned a motion it can follow; "
+        "a smaller --dt helps",
+        truth->get<double>(), kTruthLossRatio, curve.back().train_loss));
+  }
   const auto r2 = metrics.find("test_r2");
   if (r2 != metrics.end() && r2->is_number() && r2->get<double>() < kLowR2) {
     warnings.push_back(fmt::format(

@@ -365,6 +365,25 @@ TEST(RunWarnings, ALossThatDidNotFallOrAnR2NearZeroIsOneSentenceEach) {
   EXPECT_EQ(run_warnings({}, {{"test_r2", -3.0}}).size(), 1u);
 }
 
+// A model whose training loss ends far below the true system's own through the same integrator
+// learned a motion the integrator can follow, not the true one (the magnet pendulum's windows
+// through classic RK4 at the peer's step: the truth's loss 86.5 where the model's is 0.03).
+TEST(RunWarnings, ATruthLossFarAboveTheTrainingsSaysTheIntegratorCannotFollow) {
+  const std::vector<CurvePoint> curve = {{20, 1.0, 0.5}, {200, 0.03, 0.02}};
+  const std::vector<std::string> warned = run_warnings(curve, {{"truth_rollout_loss", 86.5}});
+  ASSERT_EQ(warned.size(), 1u);
+  EXPECT_TRUE(
+      warned[0].starts_with("the true system's own rollout loss through the training's "
+                            "integrator is 86.5, over 10 times the training's last loss "
+                            "(0.03)"))
+      << warned[0];
+  // At the floor (the gyroscope's 2.8e-5 against 3.1e-5), or without a curve: nothing.
+  EXPECT_TRUE(
+      run_warnings({{20, 1.0, 0.5}, {200, 3.1e-5, 3.2e-5}}, {{"truth_rollout_loss", 2.8e-5}})
+          .empty());
+  EXPECT_TRUE(run_warnings({}, {{"truth_rollout_loss", 86.5}}).empty());
+}
+
 // A diverging run (a learning rate of 1e3) ends with its warning in metrics.json; a good one
 // with an empty list.
 TEST(RunWarnings, ReachMetricsJson) {
