@@ -48,9 +48,8 @@ struct Avx2Doubles {
   // t, with x wherever x is NaN.
   static V nan_from(V t, V x) { return _mm256_blendv_pd(t, x, _mm256_cmp_pd(x, x, _CMP_UNORD_Q)); }
 };
-#endif
 
-#if defined(HNN_SIMD_DOUBLE_TANH) && defined(EIGEN_VECTORIZE_AVX512)
+#ifdef EIGEN_VECTORIZE_AVX512
 /// The same on 8 doubles (AVX-512F): the same operations lane by lane, so the same bits.
 struct Avx512Doubles {
   using V = __m512d;
@@ -80,7 +79,6 @@ struct Avx512Doubles {
 };
 #endif
 
-#ifdef HNN_SIMD_DOUBLE_TANH
 /// tanh of a packet of doubles: (E - 1) / (E + 1), E = e^{2x}, 2x clamped to [-40, 40] (beyond
 /// it tanh is +-1 in double). e^y = 2^k e^r with k = round(y / ln 2) and r = y - k ln 2 in
 /// [-ln2/2, ln2/2] (ln 2 in two parts, so that k ln 2 is exact), e^r by its Taylor series to r^12
@@ -112,7 +110,7 @@ typename Isa::V tanh_packet(typename Isa::V x) {
 }
 
 /// The widest packet this build has.
-#if defined(HNN_SIMD_DOUBLE_TANH) && defined(EIGEN_VECTORIZE_AVX512)
+#ifdef EIGEN_VECTORIZE_AVX512
 using DoublePacket = Avx512Doubles;
 #else
 using DoublePacket = Avx2Doubles;

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "autodiff/tape.h"
 #include "nn/sampled/sampled_fit.h"
 #include "tasks/task.h"
 #include "tasks/train/field_objective.h"
@@ -44,14 +45,16 @@ double FieldTraining::truth_loss(const physics::System& truth) const {
   if (!loss_.rollout || loss_.integrator == RolloutIntegrator::kMidpoint) return NAN;
   const KnownField field = [&](const Batch& z, Batch& dzdt) { truth.vector_field(z, dzdt); };
   const RolloutWindows& w = train_windows_;
+  ad::TapeScope scope;
+  ad::NoGradGuard values_only;
   Batch z = w.start;
   double total = 0;
   for (std::size_t j = 0; j < w.next.size(); ++j) {
     const Batch h = w.step[j] / double(substeps_);
     for (int s = 0; s < substeps_; ++s) z = known_field_step(field, z, h, loss_.integrator);
-    const Batch e = z - w.next[j];
-    total +=
-        loss_.norm == RolloutNorm::kL1 ? e.cwiseAbs().mean() : e.squaredNorm() / double(e.size());
+    total += rollout_error(loss_.norm, ad::Var<double>::constant(z),
+                           ad::Var<double>::constant(w.next[j]))
+                 .item();
   }
   return total / double(w.next.size());
 }

@@ -32,6 +32,15 @@ ad::Var<T> mean_absolute_error(const ad::Var<T>& a, const ad::Var<T>& b) {
 template ad::Var<float> mean_absolute_error(const ad::Var<float>&, const ad::Var<float>&);
 template ad::Var<double> mean_absolute_error(const ad::Var<double>&, const ad::Var<double>&);
 
+template <typename T>
+ad::Var<T> rollout_error(RolloutNorm norm, const ad::Var<T>& predicted,
+                         const ad::Var<T>& measured) {
+  return norm == RolloutNorm::kL1 ? mean_absolute_error(predicted, measured)
+                                  : nn::mse(predicted, measured);
+}
+template ad::Var<float> rollout_error(RolloutNorm, const ad::Var<float>&, const ad::Var<float>&);
+template ad::Var<double> rollout_error(RolloutNorm, const ad::Var<double>&, const ad::Var<double>&);
+
 namespace {
 constexpr nn::NameTable<RolloutNorm, 2> kRolloutNormNames{
     {{RolloutNorm::kL2, "l2"}, {RolloutNorm::kL1, "l1"}}};
@@ -215,9 +224,7 @@ ad::Var<T> RolloutObjective<T>::rows_loss(const nn::DynamicsModel<T>& model,
   for (std::size_t j = 0; j < horizon_; ++j) {
     const ad::Var<T> h = rows(1 + 2 * j);
     for (int s = 0; s < substeps_; ++s) z = integrator_step(model, z, h, integrator_);
-    const ad::Var<T> x = model.observed_state(z), target = rows(2 + 2 * j);
-    const ad::Var<T> step_loss =
-        norm_ == RolloutNorm::kL1 ? mean_absolute_error(x, target) : nn::mse(x, target);
+    const ad::Var<T> step_loss = rollout_error(norm_, model.observed_state(z), rows(2 + 2 * j));
     total = total.defined() ? total + step_loss : step_loss;
   }
   return total * T(1.0 / double(horizon_));

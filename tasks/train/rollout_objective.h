@@ -39,6 +39,12 @@ enum class RolloutNorm { kL2, kL1 };
 template <typename T>
 ad::Var<T> mean_absolute_error(const ad::Var<T>& a, const ad::Var<T>& b);
 
+/// The error of predicted states against measured ones under `norm`, on the tape: nn::mse, or
+/// mean_absolute_error. The one definition the training loss and the truth's loss
+/// (FieldTraining::truth_loss) both use.
+template <typename T>
+ad::Var<T> rollout_error(RolloutNorm norm, const ad::Var<T>& predicted, const ad::Var<T>& measured);
+
 /// "l2" or "l1"; parse throws Error naming both.
 std::string_view to_string(RolloutNorm norm);
 std::vector<std::string> rollout_norm_names();
