@@ -1,8 +1,9 @@
 #pragma once
 // Internal: the matrix product of the fused kernels, C = op(A) op(B) + beta C on row-major
-// matrices or row blocks of them. OpenBLAS's single-threaded GEMM when the build found it
-// (about 1.4x Eigen's at the MLP shapes on this project's machines; the kernels split batches
-// across threads themselves), Eigen's otherwise.
+// matrices or row blocks of them. The engine's own kernel on AVX-512 builds, for the shapes where
+// it beats OpenBLAS (gemm_kernel.cpp); otherwise OpenBLAS's single-threaded GEMM when the build
+// found it (about 1.4x Eigen's at the MLP shapes on this project's machines; the kernels split
+// batches across threads themselves), Eigen's otherwise.
 
 #include <Eigen/Core>
 #include <atomic>
@@ -25,6 +26,25 @@ void init_gemm();
 /// Whether the calling thread has run init_gemm: checked inline, so a GEMM pays no call for it.
 inline thread_local bool t_gemm_ready = false;
 
+/// One product C = op(A) op(B) + beta C for simd_gemm: row-major data with their row strides.
+template <typename T>
+struct GemmOperands {
+  Eigen::Index m, n, k;
+  const T* a;
+  Eigen::Index lda;
+  bool ta;
+  const T* b;
+  Eigen::Index ldb;
+  bool tb;
+  T* c;
+  Eigen::Index ldc;
+  T beta;
+};
+/// The product by the engine's own register-tiled kernel on AVX-512 builds (Note [A GEMM without
+/// packing] in gemm_kernel.cpp), where it suits the shape; false, doing nothing, elsewhere.
+template <typename T>
+bool simd_gemm(const GemmOperands<T>& g);
+
 /// Whether a GemmFlopCounter (flop_count.h) is alive, and its count.
 extern std::atomic<bool> g_counting_flops;
 void count_flops(std::uint64_t flops);
@@ -37,6 +57,11 @@ void gemm(const A& a, bool ta, const B& b, bool tb, C&& c, typename A::Scalar be
   eigen_assert((ta ? a.cols() : a.rows()) == m && (tb ? b.rows() : b.cols()) == n &&
                (tb ? b.cols() : b.rows()) == k);
   if (g_counting_flops.load(std::memory_order_relaxed)) count_flops(std::uint64_t(2 * m * n * k));
+  if (m > 1 && n >= kNarrow &&
+      simd_gemm<T>({m, n, k, a.data(), a.outerStride(), ta, b.data(), b.outerStride(), tb, c.data(),
+                    c.outerStride(), beta})) {
+    return;
+  }
 #ifdef HNN_HAVE_OPENBLAS
   if (!t_gemm_ready) init_gemm();
   const auto op = [](bool t) { return t ? CblasTrans : CblasNoTrans; };
