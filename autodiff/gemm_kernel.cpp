@@ -147,6 +147,37 @@ bool suits_the_kernel(const GemmOperands<T>& g, Index panel) {
          16 * (padded - g.n) <= g.n;
 }
 
+/// A panel of op(B) = B^T: packed[p * kPanel + jj] = b[jj * ldb + p] for jj < width <= kPanel
+/// and p < depth, in square blocks of kWidth transposed in registers (Eigen's ptranspose), 3-4x
+/// faster than element by element: that copy took a third of the time of the products it served
+/// (7% of the CHNN step).
+template <typename T>
+void pack_transposed(const T* b, Index ldb, Index width, Index depth, T* packed) {
+  using L = Lanes<T>;
+  constexpr int w = L::kWidth;
+  constexpr Index kPanel = Index(w) * kVectors;
+  // (GCC warns that a template argument drops __m512's alignment attribute; PacketBlock is
+  // Eigen's own type for exactly these registers, as in its GEMM's packing.)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wignored-attributes"
+  Eigen::internal::PacketBlock<typename L::V, w> block;
+#pragma GCC diagnostic pop
+  for (Index j0 = 0; j0 < width; j0 += w) {
+    const Index rows = std::min<Index>(w, width - j0);
+    for (Index p0 = 0; p0 < depth; p0 += w) {
+      const Index cols = std::min<Index>(w, depth - p0);
+      const auto mask = typename L::Mask((std::uint64_t(1) << cols) - 1);
+      for (int r = 0; r < w; ++r) {
+        block.packet[r] = r < rows ? L::load(b + (j0 + r) * ldb + p0, mask) : L::zero();
+      }
+      Eigen::internal::ptranspose(block);
+      for (Index q = 0; q < cols; ++q) {
+        L::store(packed + (p0 + q) * kPanel + j0, block.packet[q], typename L::Mask(~0u));
+      }
+    }
+  }
+}
+
 }  // namespace
 
 template <typename T>
@@ -166,10 +197,7 @@ bool simd_gemm(const GemmOperands<T>& g) {
       const T* b = g.b + k0 * g.ldb + j;
       Index ldb = g.ldb;
       if (g.tb) {
-        for (Index jj = 0; jj < width; ++jj) {
-          const T* column = g.b + (j + jj) * g.ldb + k0;
-          for (Index p = 0; p < depth; ++p) packed[p * kPanel + jj] = column[p];
-        }
+        pack_transposed(g.b + j * g.ldb + k0, g.ldb, width, depth, packed);
         b = packed;
         ldb = kPanel;
       }
