@@ -3,7 +3,8 @@
 // by autodiff, by central finite differences over a sweep of steps h, and analytically, with
 // each method's error against the analytic gradient. Run with --benchmark_format=json for the
 // speed-against-accuracy charts. Then the Lagrangian network's ops: batched_solve forward and
-// backward, and the per-row Hessians of an MLP by row_hessian.
+// backward, and the per-row Hessians of an MLP by row_hessian. Last, the fused kernels' matrix
+// product at the steps' shapes: the engine's AVX-512 kernel against OpenBLAS's GEMM.
 
 #include <benchmark/benchmark.h>
 
@@ -14,6 +15,7 @@
 #include <vector>
 
 #include "autodiff/autodiff.h"
+#include "autodiff/gemm.h"
 
 namespace ad = hnn::ad;
 using ad::Matrix;
@@ -288,6 +290,69 @@ void BM_RowHessian(benchmark::State& state) {
 
 BENCHMARK_TEMPLATE(BM_RowHessian, double)->ArgName("rows")->Arg(512)->Unit(benchmark::kMillisecond);
 BENCHMARK_TEMPLATE(BM_RowHessian, float)->ArgName("rows")->Arg(512)->Unit(benchmark::kMillisecond);
+
+// ---- 4. the fused kernels' matrix product ----------------------------------------------------
+
+// Args: backend (0 the engine's kernel, 1 OpenBLAS), orientation (0 A B, 1 A B^T, 2 A^T B), and
+// C's m x n with the shared k. One iteration: one product on one thread, beta 0. The counter is
+// GFLOP/s (2mnk per product); roofline_bench's BM_FmaPeak gives the core's peak to divide by.
+template <typename T>
+void BM_Gemm(benchmark::State& state) {
+  const bool blas = state.range(0) == 1;
+  const bool ta = state.range(1) == 2, tb = state.range(1) == 1;
+  const Eigen::Index m = state.range(2), n = state.range(3), k = state.range(4);
+  const Matrix<T> a = Uniform(ta ? k : m, ta ? m : k, 70, -1, 1).cast<T>();
+  const Matrix<T> b = Uniform(tb ? n : k, tb ? k : n, 71, -1, 1).cast<T>();
+  Matrix<T> c(m, n);
+  hnn::ad::detail::init_gemm();  // OpenBLAS on this thread alone, as the engine calls it
+  const hnn::ad::detail::GemmOperands<T> g{m,        n,        k,  a.data(), a.cols(), ta,
+                                           b.data(), b.cols(), tb, c.data(), n,        T(0)};
+  if (!blas && !hnn::ad::detail::simd_gemm(g)) {
+    state.SkipWithError("the engine's kernel does not take this product in this build");
+    return;
+  }
+  for (auto _ : state) {
+    if (blas) {
+#ifdef HNN_HAVE_OPENBLAS
+      const auto op = [](bool t) { return t ? CblasTrans : CblasNoTrans; };
+      if constexpr (std::is_same_v<T, float>) {
+        cblas_sgemm(CblasRowMajor, op(ta), op(tb), int(m), int(n), int(k), 1.0f, a.data(),
+                    int(a.cols()), b.data(), int(b.cols()), 0.0f, c.data(), int(n));
+      } else {
+        cblas_dgemm(CblasRowMajor, op(ta), op(tb), int(m), int(n), int(k), 1.0, a.data(),
+                    int(a.cols()), b.data(), int(b.cols()), 0.0, c.data(), int(n));
+      }
+#else
+      state.SkipWithError("this build has no OpenBLAS");
+      return;
+#endif
+    } else {
+      hnn::ad::detail::simd_gemm(g);
+    }
+    benchmark::DoNotOptimize(c.data());
+  }
+  state.counters["GFLOP/s"] = benchmark::Counter(double(2 * m * n * k) * double(state.iterations()),
+                                                 benchmark::Counter::kIsRate);
+}
+
+// The CHNN and D-HNN steps' float products (a thread's 100 rows of a 256-wide layer) and the
+// spring step's double ones (375 rows of a 200-wide layer), in all three orientations.
+void GemmShapes(benchmark::internal::Benchmark* b, std::int64_t m, std::int64_t width) {
+  b->ArgNames({"blas", "orient", "m", "n", "k"});
+  for (int orientation : {0, 1, 2}) {
+    for (int backend : {0, 1}) {
+      if (orientation == 2) {
+        b->Args({backend, orientation, width, width, m});
+      } else {
+        b->Args({backend, orientation, m, width, width});
+      }
+    }
+  }
+  b->Unit(benchmark::kMicrosecond);
+}
+
+BENCHMARK_TEMPLATE(BM_Gemm, float)->Apply([](auto* b) { GemmShapes(b, 100, 256); });
+BENCHMARK_TEMPLATE(BM_Gemm, double)->Apply([](auto* b) { GemmShapes(b, 375, 200); });
 
 }  // namespace
 
