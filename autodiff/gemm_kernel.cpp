@@ -56,9 +56,9 @@ struct Lanes<double> {
 };
 
 // The tile: kRows x kVectors accumulators, 28 of AVX-512's 32 registers; the rest hold B's row
-// and A's broadcast element. 14 x 2 ran 1.2-1.3x OpenBLAS's GEMM at 100 x 256 x 256 in float on
-// an AVX-512 Xeon, where 6 x 4 (fewer loads, a wider panel of B than the L1 cache holds) ran
-// 1.1x.
+// and A's broadcast element. 14 x 2 ran 1.1-1.3x OpenBLAS's GEMM at 100 x 256 x 256 in float on
+// an AVX-512 Xeon (the three orientations), where 6 x 4 (fewer loads, a wider panel of B than the
+// L1 cache holds) ran 1.0-1.2x.
 constexpr int kRows = 14;
 constexpr int kVectors = 2;
 // The shared dimension in blocks of this many, so that a panel of B (kDepth x kVectors vectors:
