@@ -43,7 +43,7 @@ void expect_products_match_double_products() {
           for (const Index k : kDepths) {
             for (const T beta : {T(0), T(1)}) {
               const RowMatrix<T> a_store = stored<T>(m + 3, k + 5, ta, 1);
-              const RowMatrix<T> b_store = stored<T>(k + 2, n + 7, tb, 2);
+              const RowMatrix<T> b_store = stored<T>(k + 4, n + 7, tb, 2);
               RowMatrix<T> c_store = random_matrix(m + 4, n + 6, 3).cast<T>();
               const RowMatrix<T> before = c_store;
               const auto a = ta ? a_store.block(1, 2, k, m) : a_store.block(1, 2, m, k);
