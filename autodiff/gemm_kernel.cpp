@@ -63,7 +63,10 @@ constexpr int kRows = 14;
 constexpr int kVectors = 2;
 // The shared dimension in blocks of this many, so that a panel of B (kDepth x kVectors vectors:
 // 16 KiB) and a tile's rows of A stay in the L1 cache (32 KiB on a Zen 4). The CHNN step took
-// 21.2 ms with 128, 22.7 with 256 and 24.3 with 64 (2 threads, one run each).
+// 21.2 ms with 128, 22.7 with 256 and 24.3 with 64 (2 threads, one run each). In double, 256
+// ran the spring's A B and A B^T 1.08x faster alone on the Xeon's 48 KiB L1 (autodiff_bench
+// BM_Gemm) and its step 0.96-0.99x the time, 64 1.02-1.04x; at 256 a double panel alone fills a
+// Zen 4's L1, so both types keep 128 until a Zen 4 can say.
 constexpr Index kDepth = 128;
 
 // Note [Where the kernel takes the product]: OpenBLAS's packing pays for itself on wide
