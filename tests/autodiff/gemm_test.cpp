@@ -22,10 +22,10 @@ using RowMatrix = Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMaj
 
 // Row counts around the kernel's tile height (14), column counts around its panel widths (16
 // doubles, 32 floats: 31 and 62 leave a panel's last lanes empty, 16 and 200 floats go to
-// OpenBLAS), depths around its depth block (128).
+// OpenBLAS), depths around its depth block (128), and none (C = beta C).
 constexpr Index kRowCounts[] = {2, 13, 15, 29, 100};
 constexpr Index kColumnCounts[] = {16, 31, 62, 64, 200};
-constexpr Index kDepths[] = {1, 5, 128, 129, 300};
+constexpr Index kDepths[] = {0, 1, 5, 128, 129, 300};
 
 // op(M) stored as a block of a larger matrix with a margin, so that strides differ from widths.
 template <typename T>
