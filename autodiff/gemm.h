@@ -57,6 +57,7 @@ void gemm(const A& a, bool ta, const B& b, bool tb, C&& c, typename A::Scalar be
   eigen_assert((ta ? a.cols() : a.rows()) == m && (tb ? b.rows() : b.cols()) == n &&
                (tb ? b.cols() : b.rows()) == k);
   if (g_counting_flops.load(std::memory_order_relaxed)) count_flops(std::uint64_t(2 * m * n * k));
+  // One row and narrow outputs keep the paths below (GEMV; B^T for OpenBLAS's small kernel).
   if (m > 1 && n >= kNarrow &&
       simd_gemm<T>({m, n, k, a.data(), a.outerStride(), ta, b.data(), b.outerStride(), tb, c.data(),
                     c.outerStride(), beta})) {
