@@ -72,10 +72,12 @@ constexpr Index kDepth = 128;
 // Note [Where the kernel takes the product]: OpenBLAS's packing pays for itself on wide
 // operands, where each packed panel serves many tiles, and its L2 blocking keeps them in cache;
 // there the kernel lost (the LNN's 600-wide step 1.25x slower, the pixel model's 1,568 inputs
-// 1.1x). It also wastes the lanes of a last panel that C only partly fills (the spring's 200
-// columns in float: 8 of a panel's 32). So it takes products whose C and shared dimension are at
-// most kWidest wide, with at most 1/16 of their panels' lanes empty, and leaves the rest to
-// OpenBLAS.
+// 1.1x). A last panel that C only partly fills wastes lanes: the spring's 200 columns in float
+// left 24 of a two-vector panel's 32 empty, and its step ran 1.03-1.09x slower; a last panel of
+// one vector now takes a one-vector tile, which leaves 8 of 16 empty and ran that step 0.97x the
+// time of OpenBLAS's, the rollout loss's 0.87x and the two-body's 0.91x (2 threads). So it takes
+// products whose C and shared dimension are at most kWidest wide, with at most 1/16 of their
+// vectors' lanes empty, and leaves the rest to OpenBLAS.
 constexpr Index kWidest = 384;
 
 template <typename T>
@@ -87,48 +89,56 @@ using Masks = std::array<typename Lanes<T>::Mask, kVectors>;
 /// a row of op(A) costs no register of its own. The loops over the tile are unrolled by pragma:
 /// GCC's own heuristics unrolled them after it had placed the accumulators in memory, and every
 /// step down the shared dimension stored all 28 of them.
-template <typename T, int R, bool kTransposedA>
+template <typename T, int R, int V, bool kTransposedA>
 void tile(Index depth, const T* a, Index lda, const T* b, Index ldb, T* c, Index ldc,
           const Masks<T>& m, bool accumulate) {
   const Index row_stride = kTransposedA ? 1 : lda, depth_stride = kTransposedA ? lda : 1;
   using L = Lanes<T>;
-  typename L::V acc[R][kVectors];
+  typename L::V acc[R][V];
 #pragma GCC unroll 16
   for (int r = 0; r < R; ++r) {
 #pragma GCC unroll 16
-    for (int v = 0; v < kVectors; ++v) {
+    for (int v = 0; v < V; ++v) {
       acc[r][v] = accumulate ? L::load(c + r * ldc + v * L::kWidth, m[v]) : L::zero();
     }
   }
   for (Index p = 0; p < depth; ++p) {
-    typename L::V row[kVectors];
+    typename L::V row[V];
 #pragma GCC unroll 16
-    for (int v = 0; v < kVectors; ++v) row[v] = L::load(b + p * ldb + v * L::kWidth, m[v]);
+    for (int v = 0; v < V; ++v) row[v] = L::load(b + p * ldb + v * L::kWidth, m[v]);
 #pragma GCC unroll 16
     for (int r = 0; r < R; ++r) {
       const typename L::V element = L::broadcast(a + r * row_stride + p * depth_stride);
 #pragma GCC unroll 16
-      for (int v = 0; v < kVectors; ++v) acc[r][v] = L::fma(element, row[v], acc[r][v]);
+      for (int v = 0; v < V; ++v) acc[r][v] = L::fma(element, row[v], acc[r][v]);
     }
   }
 #pragma GCC unroll 16
   for (int r = 0; r < R; ++r) {
 #pragma GCC unroll 16
-    for (int v = 0; v < kVectors; ++v) L::store(c + r * ldc + v * L::kWidth, acc[r][v], m[v]);
+    for (int v = 0; v < V; ++v) L::store(c + r * ldc + v * L::kWidth, acc[r][v], m[v]);
   }
 }
 
 template <typename T>
 using TileFn = void (*)(Index, const T*, Index, const T*, Index, T*, Index, const Masks<T>&, bool);
 
-/// tile<T, R, kTransposedA> for R = 1..kRows, at index R - 1: the last rows of a block take a
+/// tile<T, R, V, kTransposedA> for R = 1..kRows, at index R - 1: the last rows of a block take a
 /// shorter tile.
-template <typename T, bool kTransposedA, std::size_t... R>
+template <typename T, int V, bool kTransposedA, std::size_t... R>
 constexpr std::array<TileFn<T>, sizeof...(R)> tiles(std::index_sequence<R...>) {
-  return {&tile<T, int(R) + 1, kTransposedA>...};
+  return {&tile<T, int(R) + 1, V, kTransposedA>...};
 }
-template <typename T, bool kTransposedA>
-constexpr auto kTiles = tiles<T, kTransposedA>(std::make_index_sequence<kRows>());
+template <typename T, int V, bool kTransposedA>
+constexpr auto kTiles = tiles<T, V, kTransposedA>(std::make_index_sequence<kRows>());
+
+/// The tiles for a panel of `vectors` vectors (a last panel of one vector runs half the FMAs of
+/// a masked two-vector one), A transposed or not.
+template <typename T>
+const std::array<TileFn<T>, kRows>& tiles_for(int vectors, bool ta) {
+  if (vectors == 1) return ta ? kTiles<T, 1, true> : kTiles<T, 1, false>;
+  return ta ? kTiles<T, kVectors, true> : kTiles<T, kVectors, false>;
+}
 
 /// The masks of a panel with `width` of its columns in C.
 template <typename T>
@@ -144,8 +154,9 @@ Masks<T> panel_masks(Index width) {
 
 /// Where the kernel beats OpenBLAS (Note [Where the kernel takes the product]).
 template <typename T>
-bool suits_the_kernel(const GemmOperands<T>& g, Index panel) {
-  const Index padded = (g.n + panel - 1) / panel * panel;
+bool suits_the_kernel(const GemmOperands<T>& g) {
+  constexpr Index w = Lanes<T>::kWidth;
+  const Index padded = (g.n + w - 1) / w * w;
   // (An empty product, k = 0, must still scale C by beta: BLAS does that.)
   return g.m > 0 && g.k > 0 && (g.beta == T(0) || g.beta == T(1)) &&
          std::max(g.n, g.k) <= kWidest && 16 * (padded - g.n) <= g.n;
@@ -187,10 +198,9 @@ void pack_transposed(const T* b, Index ldb, Index width, Index depth, T* packed)
 template <typename T>
 bool simd_gemm(const GemmOperands<T>& g) {
   constexpr Index kPanel = Index(Lanes<T>::kWidth) * kVectors;
-  if (!suits_the_kernel(g, kPanel)) return false;
+  if (!suits_the_kernel(g)) return false;
   // B^T's panel, when B comes transposed: kDepth x kPanel on the stack (16 KiB).
   alignas(64) T packed[kDepth * kPanel];
-  const auto& tiles = g.ta ? kTiles<T, true> : kTiles<T, false>;
   const Index row_stride = g.ta ? 1 : g.lda, depth_stride = g.ta ? g.lda : 1;
   for (Index k0 = 0; k0 < g.k; k0 += kDepth) {
     const Index depth = std::min(kDepth, g.k - k0);
@@ -198,6 +208,7 @@ bool simd_gemm(const GemmOperands<T>& g) {
     for (Index j = 0; j < g.n; j += kPanel) {
       const Index width = std::min(kPanel, g.n - j);
       const Masks<T> masks = panel_masks<T>(width);
+      const auto& tiles = tiles_for<T>(width > Lanes<T>::kWidth ? kVectors : 1, g.ta);
       const T* b = g.b + k0 * g.ldb + j;
       Index ldb = g.ldb;
       if (g.tb) {
