@@ -75,9 +75,11 @@ constexpr Index kDepth = 128;
 // 1.1x). A last panel that C only partly fills wastes lanes: the spring's 200 columns in float
 // left 24 of a two-vector panel's 32 empty, and its step ran 1.03-1.09x slower; a last panel of
 // one vector now takes a one-vector tile, which leaves 8 of 16 empty and ran that step 0.97x the
-// time of OpenBLAS's, the rollout loss's 0.87x and the two-body's 0.91x (2 threads). So it takes
-// products whose C and shared dimension are at most kWidest wide, with at most 1/16 of their
-// vectors' lanes empty, and leaves the rest to OpenBLAS.
+// time of OpenBLAS's, the rollout loss's 0.87x and the two-body's 0.91x (2 threads). Many rows
+// lose too: a weight gradient over the pixel model's 1,568 inputs (C 1,568 x 200, A^T B over 100
+// rows) ran 0.94x OpenBLAS's speed alone, the pixel step 1.05-1.08x slower, as each panel streams
+// all of A again. So it takes products whose C and shared dimension are at most kWidest in every
+// direction, with at most 1/16 of their vectors' lanes empty, and leaves the rest to OpenBLAS.
 constexpr Index kWidest = 384;
 
 template <typename T>
@@ -159,7 +161,7 @@ bool suits_the_kernel(const GemmOperands<T>& g) {
   const Index padded = (g.n + w - 1) / w * w;
   // (An empty product, k = 0, must still scale C by beta: BLAS does that.)
   return g.m > 0 && g.k > 0 && (g.beta == T(0) || g.beta == T(1)) &&
-         std::max(g.n, g.k) <= kWidest && 16 * (padded - g.n) <= g.n;
+         std::max({g.m, g.n, g.k}) <= kWidest && 16 * (padded - g.n) <= g.n;
 }
 
 /// A panel of op(B) = B^T: packed[p * kPanel + jj] = b[jj * ldb + p] for jj < width <= kPanel
