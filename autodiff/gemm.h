@@ -45,6 +45,23 @@ struct GemmOperands {
 template <typename T>
 bool simd_gemm(const GemmOperands<T>& g);
 
+#ifdef HNN_HAVE_OPENBLAS
+/// The product by OpenBLAS's GEMM on the calling thread alone (the general path of gemm below;
+/// autodiff_bench measures the kernel against it).
+template <typename T>
+void blas_gemm(const GemmOperands<T>& g) {
+  if (!t_gemm_ready) init_gemm();
+  const auto op = [](bool t) { return t ? CblasTrans : CblasNoTrans; };
+  if constexpr (std::is_same_v<T, float>) {
+    cblas_sgemm(CblasRowMajor, op(g.ta), op(g.tb), int(g.m), int(g.n), int(g.k), 1.0f, g.a,
+                int(g.lda), g.b, int(g.ldb), g.beta, g.c, int(g.ldc));
+  } else {
+    cblas_dgemm(CblasRowMajor, op(g.ta), op(g.tb), int(g.m), int(g.n), int(g.k), 1.0, g.a,
+                int(g.lda), g.b, int(g.ldb), g.beta, g.c, int(g.ldc));
+  }
+}
+#endif
+
 /// Whether a GemmFlopCounter (flop_count.h) is alive, and its count.
 extern std::atomic<bool> g_counting_flops;
 void count_flops(std::uint64_t flops);
@@ -57,31 +74,35 @@ void gemm(const A& a, bool ta, const B& b, bool tb, C&& c, typename A::Scalar be
   eigen_assert((ta ? a.cols() : a.rows()) == m && (tb ? b.rows() : b.cols()) == n &&
                (tb ? b.cols() : b.rows()) == k);
   if (g_counting_flops.load(std::memory_order_relaxed)) count_flops(std::uint64_t(2 * m * n * k));
+  GemmOperands<T> g{m,
+                    n,
+                    k,
+                    a.data(),
+                    a.outerStride(),
+                    ta,
+                    b.data(),
+                    b.outerStride(),
+                    tb,
+                    c.data(),
+                    c.outerStride(),
+                    beta};
   // One row and narrow outputs keep the paths below (GEMV; B^T for OpenBLAS's small kernel).
-  if (m > 1 && n >= kNarrow &&
-      simd_gemm<T>({m, n, k, a.data(), a.outerStride(), ta, b.data(), b.outerStride(), tb, c.data(),
-                    c.outerStride(), beta})) {
-    return;
-  }
+  if (m > 1 && n >= kNarrow && simd_gemm(g)) return;
 #ifdef HNN_HAVE_OPENBLAS
   if (!t_gemm_ready) init_gemm();
-  const auto op = [](bool t) { return t ? CblasTrans : CblasNoTrans; };
-  const int lda = int(a.outerStride()), ldc = int(c.outerStride());
-  int ldb = int(b.outerStride());
-  const T* b_data = b.data();
   if (m == 1) {
     // One row (a rollout's single state): GEMM packs all of B for it, and its packing and kernel
     // took 83% of an evaluation on the spring's 200 x 200 layers; GEMV reads B once.
     // c^T = op(B)^T a^T.
-    const int inc_a = ta ? lda : 1;
+    const int inc_a = ta ? int(g.lda) : 1;
     const auto b_op = tb ? CblasNoTrans : CblasTrans;
     const int rows_b = int(tb ? n : k), cols_b = int(tb ? k : n);
     if constexpr (std::is_same_v<T, float>) {
-      cblas_sgemv(CblasRowMajor, b_op, rows_b, cols_b, 1.0f, b_data, ldb, a.data(), inc_a, beta,
-                  c.data(), 1);
+      cblas_sgemv(CblasRowMajor, b_op, rows_b, cols_b, 1.0f, g.b, int(g.ldb), g.a, inc_a, beta, g.c,
+                  1);
     } else {
-      cblas_dgemv(CblasRowMajor, b_op, rows_b, cols_b, 1.0, b_data, ldb, a.data(), inc_a, beta,
-                  c.data(), 1);
+      cblas_dgemv(CblasRowMajor, b_op, rows_b, cols_b, 1.0, g.b, int(g.ldb), g.a, inc_a, beta, g.c,
+                  1);
     }
     return;
   }
@@ -102,17 +123,11 @@ void gemm(const A& a, bool ta, const B& b, bool tb, C&& c, typename A::Scalar be
       b_t = wide.data();
     }
     Eigen::Map<RowMatrix>(b_t, n, k) = b.transpose();
-    b_data = b_t;
-    ldb = int(k);
-    tb = true;
+    g.b = b_t;
+    g.ldb = k;
+    g.tb = true;
   }
-  if constexpr (std::is_same_v<T, float>) {
-    cblas_sgemm(CblasRowMajor, op(ta), op(tb), int(m), int(n), int(k), 1.0f, a.data(), lda, b_data,
-                ldb, beta, c.data(), ldc);
-  } else {
-    cblas_dgemm(CblasRowMajor, op(ta), op(tb), int(m), int(n), int(k), 1.0, a.data(), lda, b_data,
-                ldb, beta, c.data(), ldc);
-  }
+  blas_gemm(g);
 #else
   const auto product = [&](auto&& lhs, auto&& rhs) {
     if (beta == T(0)) {

@@ -84,6 +84,15 @@ constexpr Index kWidest = 384;
 
 template <typename T>
 using Masks = std::array<typename Lanes<T>::Mask, kVectors>;
+/// Columns of C per panel: kVectors vectors.
+template <typename T>
+constexpr Index kPanel = Index(Lanes<T>::kWidth) * kVectors;
+
+/// The mask of a vector's first `count` lanes (count <= its width).
+template <typename T>
+typename Lanes<T>::Mask first_lanes(Index count) {
+  return typename Lanes<T>::Mask((std::uint64_t(1) << count) - 1);
+}
 
 /// C's rows [0, R) and a panel of its columns (masks say which) += or = op(A)'s rows [0, R)
 /// times the panel of B (rows of stride ldb), over `depth` terms. op(A)'s element (r, p) is
@@ -148,8 +157,7 @@ Masks<T> panel_masks(Index width) {
   constexpr int w = Lanes<T>::kWidth;
   Masks<T> m{};
   for (int v = 0; v < kVectors; ++v) {
-    const Index lanes = std::clamp<Index>(width - v * w, 0, w);
-    m[std::size_t(v)] = typename Lanes<T>::Mask((std::uint64_t(1) << lanes) - 1);
+    m[std::size_t(v)] = first_lanes<T>(std::clamp<Index>(width - v * w, 0, w));
   }
   return m;
 }
@@ -164,7 +172,7 @@ bool suits_the_kernel(const GemmOperands<T>& g) {
          std::max({g.m, g.n, g.k}) <= kWidest && 16 * (padded - g.n) <= g.n;
 }
 
-/// A panel of op(B) = B^T: packed[p * kPanel + jj] = b[jj * ldb + p] for jj < width <= kPanel
+/// A panel of op(B) = B^T: packed[p * kPanel<T> + jj] = b[jj * ldb + p] for jj < width <= kPanel
 /// and p < depth, in square blocks of kWidth transposed in registers (Eigen's ptranspose).
 /// Element by element, that copy took a third of the time of the products it served: the CHNN
 /// step spent 7.3% in simd_gemm's own code then, 3.3% now (perf).
@@ -172,7 +180,6 @@ template <typename T>
 void pack_transposed(const T* b, Index ldb, Index width, Index depth, T* packed) {
   using L = Lanes<T>;
   constexpr int w = L::kWidth;
-  constexpr Index kPanel = Index(w) * kVectors;
   // (GCC warns that a template argument drops __m512's alignment attribute; PacketBlock is
   // Eigen's own type for exactly these registers, as in its GEMM's packing.)
 #pragma GCC diagnostic push
@@ -183,13 +190,13 @@ void pack_transposed(const T* b, Index ldb, Index width, Index depth, T* packed)
     const Index rows = std::min<Index>(w, width - j0);
     for (Index p0 = 0; p0 < depth; p0 += w) {
       const Index cols = std::min<Index>(w, depth - p0);
-      const auto mask = typename L::Mask((std::uint64_t(1) << cols) - 1);
+      const auto mask = first_lanes<T>(cols);
       for (int r = 0; r < w; ++r) {
         block.packet[r] = r < rows ? L::load(b + (j0 + r) * ldb + p0, mask) : L::zero();
       }
       Eigen::internal::ptranspose(block);
       for (Index q = 0; q < cols; ++q) {
-        L::store(packed + (p0 + q) * kPanel + j0, block.packet[q], typename L::Mask(~0u));
+        L::store(packed + (p0 + q) * kPanel<T> + j0, block.packet[q], first_lanes<T>(w));
       }
     }
   }
@@ -199,16 +206,15 @@ void pack_transposed(const T* b, Index ldb, Index width, Index depth, T* packed)
 
 template <typename T>
 bool simd_gemm(const GemmOperands<T>& g) {
-  constexpr Index kPanel = Index(Lanes<T>::kWidth) * kVectors;
   if (!suits_the_kernel(g)) return false;
   // B^T's panel, when B comes transposed: kDepth x kPanel on the stack (16 KiB).
-  alignas(64) T packed[kDepth * kPanel];
+  alignas(64) T packed[kDepth * kPanel<T>];
   const Index row_stride = g.ta ? 1 : g.lda, depth_stride = g.ta ? g.lda : 1;
   for (Index k0 = 0; k0 < g.k; k0 += kDepth) {
     const Index depth = std::min(kDepth, g.k - k0);
     const bool accumulate = k0 > 0 || g.beta == T(1);
-    for (Index j = 0; j < g.n; j += kPanel) {
-      const Index width = std::min(kPanel, g.n - j);
+    for (Index j = 0; j < g.n; j += kPanel<T>) {
+      const Index width = std::min(kPanel<T>, g.n - j);
       const Masks<T> masks = panel_masks<T>(width);
       const auto& tiles = tiles_for<T>(width > Lanes<T>::kWidth ? kVectors : 1, g.ta);
       const T* b = g.b + k0 * g.ldb + j;
@@ -216,7 +222,7 @@ bool simd_gemm(const GemmOperands<T>& g) {
       if (g.tb) {
         pack_transposed(g.b + j * g.ldb + k0, g.ldb, width, depth, packed);
         b = packed;
-        ldb = kPanel;
+        ldb = kPanel<T>;
       }
       // The rows in tiles of equal height, within one: 100 rows as 4 x 13 and 4 x 12, not
       // 7 x 14 and a tile of 2, whose 4 accumulators would wait on its loads.

@@ -304,7 +304,6 @@ void BM_Gemm(benchmark::State& state) {
   const Matrix<T> a = Uniform(ta ? k : m, ta ? m : k, 70, -1, 1).cast<T>();
   const Matrix<T> b = Uniform(tb ? n : k, tb ? k : n, 71, -1, 1).cast<T>();
   Matrix<T> c(m, n);
-  hnn::ad::detail::init_gemm();  // OpenBLAS on this thread alone, as the engine calls it
   const hnn::ad::detail::GemmOperands<T> g{m,        n,        k,  a.data(), a.cols(), ta,
                                            b.data(), b.cols(), tb, c.data(), n,        T(0)};
   if (!blas && !hnn::ad::detail::simd_gemm(g)) {
@@ -314,14 +313,7 @@ void BM_Gemm(benchmark::State& state) {
   for (auto _ : state) {
     if (blas) {
 #ifdef HNN_HAVE_OPENBLAS
-      const auto op = [](bool t) { return t ? CblasTrans : CblasNoTrans; };
-      if constexpr (std::is_same_v<T, float>) {
-        cblas_sgemm(CblasRowMajor, op(ta), op(tb), int(m), int(n), int(k), 1.0f, a.data(),
-                    int(a.cols()), b.data(), int(b.cols()), 0.0f, c.data(), int(n));
-      } else {
-        cblas_dgemm(CblasRowMajor, op(ta), op(tb), int(m), int(n), int(k), 1.0, a.data(),
-                    int(a.cols()), b.data(), int(b.cols()), 0.0, c.data(), int(n));
-      }
+      hnn::ad::detail::blas_gemm(g);
 #else
       state.SkipWithError("this build has no OpenBLAS");
       return;
