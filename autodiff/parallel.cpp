@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "autodiff/check.h"
+#include "autodiff/float_mode.h"
 
 namespace hnn::ad {
 
@@ -56,6 +57,7 @@ class Pool {
     std::unique_lock lock(busy_, std::try_to_lock);
     if (!lock.owns_lock() || std::uint64_t(parts) > kField) return serial(parts, part);
     job_ = &part;
+    mode_ = float_mode();
     if (errors_.size() < std::size_t(parts)) errors_.resize(std::size_t(parts));
     std::fill_n(errors_.begin(), parts, nullptr);
     done_.store(0, std::memory_order_relaxed);
@@ -120,7 +122,9 @@ class Pool {
     return {.word = word};
   }
 
+  // In the caller's floating-point mode (Note [Denormals flushed] in float_mode.h).
   void run_part(int i, int parts) {
+    set_float_mode(mode_);
     g_inside_part = true;
     try {
       (*job_)(i);
@@ -184,6 +188,7 @@ class Pool {
   std::atomic<bool> stop_{false};
   std::uint64_t generation_ = 0;  // the caller's copy (under busy_)
   const PartFn* job_ = nullptr;
+  FloatMode mode_ = 0;                            // the caller's, published with job_
   std::unique_ptr<std::atomic<bool>[]> started_;  // per part of a pinned job
 };
 

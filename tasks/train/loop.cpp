@@ -10,6 +10,7 @@
 #include <string_view>
 
 #include "autodiff/check.h"
+#include "autodiff/float_mode.h"
 #include "autodiff/grad.h"
 #include "autodiff/parallel.h"
 #include "autodiff/tape.h"
@@ -254,6 +255,7 @@ double lr_factor(LrSchedule schedule, long step, long steps) {
 template <typename T>
 TrainResult train(Objective<T>& objective, const LoopOptions& o) {
   HNN_TASKS_CHECK(o.steps > 0, "steps must be positive, got {}", o.steps);
+  const ad::FlushDenormals flush;  // Note [Denormals flushed] in autodiff/float_mode.h
   Loop<T> loop(objective, o);
   const long first = loop.start();
   Progress progress(o.label, o.steps, o.quiet);

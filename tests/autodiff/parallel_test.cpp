@@ -1,19 +1,22 @@
 // The engine's worker pool (autodiff/parallel.h): every part of every job runs exactly once,
 // whoever claims it (Note [Claimed parts]), also with jobs from several threads at once and with
 // nested calls; the lowest failing part's exception reaches the caller; the pool survives a
-// change of thread count.
+// change of thread count; every part runs in its caller's floating-point mode.
 
 #include "autodiff/parallel.h"
 
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <bit>
+#include <cstdint>
 #include <stdexcept>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include "autodiff/check.h"
+#include "autodiff/float_mode.h"
 
 namespace ad = hnn::ad;
 
@@ -131,6 +134,58 @@ TEST(ParallelForEachThread, RunsPartIOnThreadIOrOnTheCaller) {
   });
   EXPECT_EQ(inner.load(), 4);
   EXPECT_EQ(ad::available_threads(), 2);
+}
+
+// A product below float's normal range: 1e-40 as it is, 0 with denormals flushed. Its factors
+// are volatile, so that the compiler cannot fold it.
+float DenormalProduct() {
+  volatile float tiny = 1e-30f, small = 1e-10f;
+  return tiny * small;
+}
+
+// Each part's product, and how many of a run of two-part jobs had part 1 on a worker.
+struct PartProducts {
+  int zero = 0, nonzero = 0, on_a_worker = 0;
+};
+PartProducts ProductsInParts(int jobs) {
+  PartProducts out;
+  const std::thread::id caller = std::this_thread::get_id();
+  for (int job = 0; job < jobs; ++job) {
+    float product[2];
+    std::thread::id ran[2];
+    ad::parallel_for_each_thread(2, [&](int i) {
+      for (int k = 0; k < 10; ++k) Busy();  // long enough for the worker to start its part
+      product[i] = DenormalProduct();
+      ran[i] = std::this_thread::get_id();
+    });
+    // By its bits: with denormals-are-zero on this thread, a comparison would read 1e-40 as 0.
+    for (float p : product) (std::bit_cast<std::uint32_t>(p) == 0 ? out.zero : out.nonzero) += 1;
+    out.on_a_worker += ran[1] != caller;
+  }
+  return out;
+}
+
+TEST(FlushDenormals, FlushesOnTheCallersThreadAndInItsPartsAndRestoresTheModeAfter) {
+#if !defined(__SSE3__)
+  GTEST_SKIP() << "this build leaves the floating-point mode alone";
+#endif
+  ad::set_num_threads(2);
+  const ad::FloatMode before = ad::float_mode();
+  ASSERT_NE(std::bit_cast<std::uint32_t>(DenormalProduct()), 0u) << "denormals flushed already";
+  EXPECT_EQ(ProductsInParts(200).zero, 0);
+  {
+    const ad::FlushDenormals flush;
+    EXPECT_EQ(std::bit_cast<std::uint32_t>(DenormalProduct()), 0u);
+    const PartProducts inside = ProductsInParts(200);
+    EXPECT_EQ(inside.nonzero, 0);
+    EXPECT_GT(inside.on_a_worker, 0) << "no part ran on a worker: the test says nothing";
+  }
+  EXPECT_EQ(ad::float_mode(), before);
+  EXPECT_NE(std::bit_cast<std::uint32_t>(DenormalProduct()), 0u);
+  // The workers that flushed for the last job follow the caller back.
+  const PartProducts after = ProductsInParts(200);
+  EXPECT_EQ(after.zero, 0);
+  EXPECT_GT(after.on_a_worker, 0);
 }
 
 // Element blocks tile [0, n) in order and start at whole 16-element packets.
