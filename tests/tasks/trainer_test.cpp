@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 
+#include "autodiff/float_mode.h"
 #include "autodiff/parallel.h"
 #include "nn/hnn.h"
 #include "nn/parameter_file.h"
@@ -301,6 +302,19 @@ TEST(Trainer, NonFiniteLossStopsWithTrainingDiverged) {
     EXPECT_EQ(e.step(), 1);
     EXPECT_NE(std::string(e.what()).find("step 1"), std::string::npos) << e.what();
   }
+}
+
+// Training flushes denormals while it runs (Note [Denormals flushed]); the caller gets its own
+// mode back after, also when training stops on an error.
+TEST(Trainer, GivesTheCallersFloatingPointModeBack) {
+  const ad::FloatMode before = ad::float_mode();
+  Dataset d = make_field_task("spring")->build_dataset(0);
+  auto model = new_model<float>("hnn", 2, {16, 16}, 3);
+  train_model<float>(*model, d, tiny_config(5), 0, {.quiet = true});
+  EXPECT_EQ(ad::float_mode(), before);
+  d.train_dxdt(5, 1) = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(train_model<float>(*model, d, tiny_config(5), 0, {.quiet = true}), TrainingDiverged);
+  EXPECT_EQ(ad::float_mode(), before);
 }
 
 // Cosine decay: the set rate at step 1, half of it half-way, nearly 0 at the last step.
