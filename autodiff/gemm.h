@@ -89,8 +89,8 @@ void gemm(const A& a, bool ta, const B& b, bool tb, C&& c, typename A::Scalar be
   // One row and narrow outputs keep the paths below (GEMV; B^T for OpenBLAS's small kernel).
   if (m > 1 && n >= kNarrow && simd_gemm(g)) return;
 #ifdef HNN_HAVE_OPENBLAS
-  if (!t_gemm_ready) init_gemm();
   if (m == 1) {
+    if (!t_gemm_ready) init_gemm();  // (blas_gemm below sees to its own)
     // One row (a rollout's single state): GEMM packs all of B for it, and its packing and kernel
     // took 83% of an evaluation on the spring's 200 x 200 layers; GEMV reads B once.
     // c^T = op(B)^T a^T.

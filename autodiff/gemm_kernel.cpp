@@ -115,6 +115,10 @@ void tile(Index depth, const T* a, Index lda, const T* b, Index ldb, T* c, Index
     if constexpr (kMasked) return L::load(p, m[std::size_t(v)]);
     return L::load(p);
   };
+  const auto store = [&m](T* p, typename L::V x, int v) {
+    if constexpr (kMasked) return L::store(p, x, m[std::size_t(v)]);
+    return L::store(p, x);
+  };
   typename L::V acc[R][V];
 #pragma GCC unroll 16
   for (int r = 0; r < R; ++r) {
@@ -137,13 +141,7 @@ void tile(Index depth, const T* a, Index lda, const T* b, Index ldb, T* c, Index
 #pragma GCC unroll 16
   for (int r = 0; r < R; ++r) {
 #pragma GCC unroll 16
-    for (int v = 0; v < V; ++v) {
-      if constexpr (kMasked) {
-        L::store(c + r * ldc + v * L::kWidth, acc[r][v], m[std::size_t(v)]);
-      } else {
-        L::store(c + r * ldc + v * L::kWidth, acc[r][v]);
-      }
-    }
+    for (int v = 0; v < V; ++v) store(c + r * ldc + v * L::kWidth, acc[r][v], v);
   }
 }
 
@@ -219,7 +217,7 @@ void pack_transposed(const T* b, Index ldb, Index width, Index depth, T* packed)
       }
       Eigen::internal::ptranspose(block);
       for (Index q = 0; q < cols; ++q) {
-        L::store(packed + (p0 + q) * kPanel<T> + j0, block.packet[q], first_lanes<T>(w));
+        L::store(packed + (p0 + q) * kPanel<T> + j0, block.packet[q]);
       }
     }
   }
